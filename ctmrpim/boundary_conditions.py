@@ -1,0 +1,64 @@
+"""Boundary conditions on a node cloud: `where` selectors evaluated into node and segment tags.
+
+Selectors are evaluated once, on the reference configuration: constraints select boundary nodes,
+tractions and pressures select boundary segments whose two end nodes both match (so a corner node
+alone never loads the adjacent face). A selector that matches nothing is an error.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .ctm import BoundaryQuadrature, boundary_points
+from .errors import ProblemError
+from .problem import Problem
+
+TRACTION_GAUSS_POINTS = 3  # per boundary segment; exact for the cantilever's parabolic shear
+
+
+def constrained_dofs(problem: Problem, nodes: np.ndarray, boundary_nodes: np.ndarray,
+                     tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Fixed dofs (blocked order) and their values; a later constraint overrides an earlier one."""
+    n = len(nodes)
+    values: dict[int, float] = {}
+    bx, by = nodes[boundary_nodes, 0], nodes[boundary_nodes, 1]
+    for i, c in enumerate(problem.constraints):
+        sel = boundary_nodes[np.asarray(c.where(bx, by, eq_tol=tol), bool)]
+        if len(sel) == 0:
+            raise ProblemError(f"where = {c.where.text!r} selects no boundary node", key=f"constraint[{i}].where")
+        for comp, f in ((0, c.ux), (1, c.uy)):
+            if f is not None:
+                v = f(nodes[sel, 0], nodes[sel, 1])
+                values.update(zip((comp * n + sel).tolist(), v.tolist()))
+    dofs = np.fromiter(values.keys(), int, len(values))
+    vals = np.fromiter(values.values(), float, len(values))
+    order = np.argsort(dofs)
+    return dofs[order], vals[order]
+
+
+def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol: float
+                    ) -> tuple[BoundaryQuadrature, np.ndarray, np.ndarray]:
+    """Gauss points on every loaded boundary segment and the traction (tx, ty) at each point."""
+    x, y = nodes[:, 0], nodes[:, 1]
+    pts, wts, nrm, tx_all, ty_all = [], [], [], [], []
+    loads = [("traction", i, t.where) for i, t in enumerate(problem.tractions)] + \
+            [("pressure", i, p.where) for i, p in enumerate(problem.pressures)]
+    for kind, i, where in loads:
+        match = np.asarray(where(x, y, eq_tol=tol), bool)
+        seg = edges[match[edges[:, 0]] & match[edges[:, 1]]]
+        if len(seg) == 0:
+            raise ProblemError(f"where = {where.text!r} selects no boundary segment", key=f"{kind}[{i}].where")
+        q = boundary_points(nodes[seg], TRACTION_GAUSS_POINTS)
+        px, py = q.points[:, 0], q.points[:, 1]
+        if kind == "traction":
+            t = problem.tractions[i]
+            tx = t.tx(px, py) if t.tx is not None else np.zeros(len(px))
+            ty = t.ty(px, py) if t.ty is not None else np.zeros(len(px))
+        else:
+            p = problem.pressures[i].p(px, py)
+            tx, ty = -p * q.normals[:, 0], -p * q.normals[:, 1]
+        pts.append(q.points); wts.append(q.weights); nrm.append(q.normals); tx_all.append(tx); ty_all.append(ty)
+    if not pts:
+        empty = BoundaryQuadrature(np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, int))
+        return empty, np.zeros(0), np.zeros(0)
+    q = BoundaryQuadrature(np.concatenate(pts), np.concatenate(wts), np.concatenate(nrm), np.zeros(0, int))
+    return q, np.concatenate(tx_all), np.concatenate(ty_all)

@@ -1,0 +1,147 @@
+"""Command line: ``ctmrpim list | run TARGET | report``.
+
+User mistakes (a bad problem file, an unknown benchmark, a selector that matches nothing) end with
+one line on stderr naming the file, key and reason, exit status 2, no traceback, and nothing written.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import warnings
+from pathlib import Path
+
+from . import benchmarks
+from .errors import ProblemError
+from .problem_file import Case, load_case
+from .result import Result
+
+ELEMENTS = ("q1", "p1", "p2")
+
+
+def load_target(target: str, overrides: list[str]) -> Case:
+    """A benchmark name or a path to a problem file."""
+    if target in benchmarks.names():
+        return benchmarks.load(target, overrides)
+    p = Path(target)
+    if p.suffix == ".toml" or p.exists():
+        return load_case(p, overrides)
+    raise ProblemError(f"{target!r} is neither a benchmark ({', '.join(benchmarks.names())}) nor a problem file")
+
+
+def solve(case: Case, solver: str, element: str) -> Result:
+    if solver == "fem":
+        from reference_fem import solve_fem
+        return solve_fem(case, element)
+    from .linear_static import solve_ctmrpim
+    return solve_ctmrpim(case)
+
+
+def describe(result: Result, case: Case) -> str:
+    c, t = result.counts, result.timings
+    head = f"{case.problem.name} ({result.method}): {c.get('nodes')} nodes"
+    d_c = result.parameters.get("derived", {}).get("d_c") or result.parameters.get("d_c")
+    if d_c:
+        head += f", d_c = {d_c:.4g}"
+    head += f", {c.get('integration_points')} integration points"
+    if "support_size" in c:
+        s = c["support_size"]
+        head += f", support {s['min']}/{s['mean']:.1f}/{s['max']} nodes (min/mean/max)"
+    lines = [head]
+    perr = result.errors.get("probes", {})
+    for name, rec in result.probes.items():
+        line = f"  probe {name} ({rec['x']:g}, {rec['y']:g}): ux = {rec['ux']:.6e}, uy = {rec['uy']:.6e}"
+        e = perr.get(name, {})
+        if "uy" in e:
+            line += f"; error in uy {100 * e['uy']:.4g} %"
+        elif "u" in e:
+            line += f"; error in |u| {100 * e['u']:.4g} %"
+        lines.append(line)
+    if "l2" in result.errors or "energy" in result.errors:
+        lines.append("  relative errors: " + ", ".join(
+            f"{k} {100 * result.errors[k]:.4g} %" for k in ("l2", "energy") if k in result.errors))
+    phases = ", ".join(f"{k.replace('_', ' ')} {v:.3f}" for k, v in t.items() if k != "total")
+    lines.append(f"  time: {t['total']:.3f} s ({phases})")
+    return "\n".join(lines)
+
+
+def cmd_list(args: argparse.Namespace) -> int:
+    for name in benchmarks.names():
+        case = benchmarks.load(name)
+        print(f"{name:16s} {case.resolved['problem']['name']}: {_description(name)}")
+    return 0
+
+
+def _description(name: str) -> str:
+    import tomllib
+    return tomllib.loads(benchmarks.path(name).read_text()).get("problem", {}).get("description", "")
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from .output import write_summary, write_vtu
+
+    case = load_target(args.target, args.set or [])
+    result = solve(case, args.solver, args.element)
+    suffix = "" if args.solver == "ctm-rpim" else f"-fem-{args.element}"
+    out = Path(args.out) if args.out else Path("runs") / f"{case.problem.name}{suffix}"
+    paths = [write_summary(result, out, case.source), write_vtu(result, out)]
+    if not args.quiet:
+        print(describe(result, case))
+        print("  wrote " + ", ".join(str(p) for p in paths))
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    from .report import make_report
+    path = make_report(quick=not args.full, out_dir=Path(args.out))
+    print(f"wrote {path}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="ctmrpim", description="Adaptive CTM-RPIM meshfree solver and verification suite")
+    sub = ap.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("list", help="list the benchmark problems")
+    p.set_defaults(func=cmd_list)
+    p = sub.add_parser("run", help="solve a benchmark or a TOML problem file")
+    p.add_argument("target", help="benchmark name (see `ctmrpim list`) or path to a problem file")
+    p.add_argument("--out", help="output folder (default runs/NAME)")
+    p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE",
+                   help="override a problem-file value, e.g. --set nodes.grid=[65,17] (repeatable)")
+    p.add_argument("--solver", choices=("ctm-rpim", "fem"), default="ctm-rpim")
+    p.add_argument("--element", choices=ELEMENTS, default="q1", help="FEM element (with --solver fem)")
+    p.add_argument("--quiet", action="store_true", help="print nothing on success")
+    p.set_defaults(func=cmd_run)
+    p = sub.add_parser("report", help="regenerate the verification report")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--quick", action="store_true", help="quick mode (default)")
+    g.add_argument("--full", action="store_true", help="paper resolution")
+    p.add_argument("--out", default="reports", help="report folder (default reports/)")
+    p.set_defaults(func=cmd_report)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", UserWarning)
+        library_show = warnings.showwarning
+
+        def show(message, category, *rest, **kw):
+            if issubclass(category, UserWarning):  # ctmrpim's own advice to the user: one plain line
+                print(f"ctmrpim: warning: {message}", file=sys.stderr)
+            else:
+                library_show(message, category, *rest, **kw)
+
+        warnings.showwarning = show
+        try:
+            return args.func(args)
+        except ProblemError as exc:
+            print(f"ctmrpim: error: {exc.message}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print("ctmrpim: interrupted", file=sys.stderr)
+            return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,148 @@
+"""CTM-RPIM linear elastostatics of one configuration, end to end (Sections 2.1.3, 2.2-2.4).
+
+field nodes --alpha shape--> boundary loops --CTM--> integration points and weights
+            --boundary Gauss--> traction points --RPIM--> sparse shape functions
+            --assembly--> K, F --direct constraints + sparse LU--> U --> stresses, probes, errors
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from . import assembly
+from .alpha_shape import Boundary, alpha_shape, validate
+from .boundary_conditions import constrained_dofs, loaded_boundary
+from .ctm import Quadrature, integration_points
+from .error_norms import relative_errors
+from .errors import ProblemError
+from .linear_solver import solve_constrained
+from .method import mean_node_spacing
+from .nodes import check_nodes_inside, make_nodes
+from .problem_file import Case
+from .result import Result, probe_errors, probe_record
+from .rpim import shape_functions
+
+#: Error-norm quadrature: bands and sub-segments at most this many d_c, this many Gauss points each way.
+ERROR_CELL = 1.5
+ERROR_GAUSS = 3
+#: The tracked boundary may differ from the geometry's area by this many d_c times its perimeter.
+AREA_TOLERANCE = 0.05
+
+
+@dataclass
+class Discretisation:
+    nodes: np.ndarray
+    d_c: float
+    boundary: Boundary
+    quadrature: Quadrature
+
+
+class Timer:
+    def __init__(self) -> None:
+        self.t0 = self.last = time.perf_counter()
+        self.phases: dict[str, float] = {}
+
+    def lap(self, name: str) -> None:
+        now = time.perf_counter()
+        self.phases[name] = self.phases.get(name, 0.0) + now - self.last
+        self.last = now
+
+    def total(self) -> dict[str, float]:
+        return {**self.phases, "total": time.perf_counter() - self.t0}
+
+
+def track_boundary(case: Case, nodes: np.ndarray, d_c: float) -> Boundary:
+    """The body's boundary from the node cloud (alpha shape), checked against the geometry's area."""
+    geometry = case.problem.geometry
+    boundary = alpha_shape(nodes, case.method.alpha * d_c, d_c)
+    if len(boundary.detached):
+        i = boundary.detached[0]
+        raise ProblemError(f"{len(boundary.detached)} node(s) are outside the alpha shape, e.g. #{i} at "
+                           f"({nodes[i, 0]:g}, {nodes[i, 1]:g}); increase method.alpha", key="method.alpha")
+    validate(boundary, expected_area=geometry.area, area_tol=AREA_TOLERANCE * d_c * geometry.perimeter)
+    return boundary
+
+
+def discretise(case: Case, timer: Timer) -> Discretisation:
+    geometry, method = case.problem.geometry, case.method
+    nodes = make_nodes(geometry, case.nodes, case.base_dir)
+    d_c = mean_node_spacing(geometry.area, len(nodes))
+    check_nodes_inside(geometry, nodes, tol=method.match_tolerance * d_c)
+    boundary = track_boundary(case, nodes, d_c)
+    timer.lap("boundary")
+    loops = boundary.loop_coordinates() if method.boundary == "alpha" else geometry.loops()
+    r_x, r_y = (s * d_c for s in method.line_spacing)
+    quad = integration_points(loops, r_x, r_y, method.gauss_points, mode="uniform")
+    timer.lap("integration")
+    return Discretisation(nodes=nodes, d_c=d_c, boundary=boundary, quadrature=quad)
+
+
+def solve_ctmrpim(case: Case) -> Result:
+    """Solve a linear-elastic Case with CTM-RPIM."""
+    problem, method = case.problem, case.method
+    timer = Timer()
+    disc = discretise(case, timer)
+    nodes, d_c, quad = disc.nodes, disc.d_c, disc.quadrature
+    tol = method.match_tolerance * d_c
+    boundary_nodes = np.unique(np.concatenate(disc.boundary.loops))
+    fixed, fixed_values = constrained_dofs(problem, nodes, boundary_nodes, tol)
+    traction_q, tx, ty = loaded_boundary(problem, nodes, disc.boundary.edges, tol)
+    timer.lap("integration")
+
+    tree = cKDTree(nodes)
+    rpim = dict(support_radius=method.support_radius * d_c, eta=method.eta,
+                polynomial_terms=method.polynomial_terms, scale=d_c, tree=tree)
+    sf = shape_functions(nodes, quad.points, **rpim)
+    sf_t = shape_functions(nodes, traction_q.points, derivatives=False, **rpim)
+    timer.lap("shape_functions")
+
+    D = problem.D()
+    K = assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights * problem.thickness, D)
+    F = assembly.load_vector(sf_t.N, traction_q.weights * problem.thickness, tx, ty)
+    timer.lap("assembly")
+
+    U = solve_constrained(K, F, fixed, fixed_values, method.solver)
+    u = U.reshape(2, -1).T
+    timer.lap("solve")
+
+    sf_n = shape_functions(nodes, nodes, **rpim)
+    stress = assembly.strain(sf_n.dNdx, sf_n.dNdy, u) @ D.T
+    probes = {}
+    if problem.probes:
+        pp = np.array([[p.x, p.y] for p in problem.probes])
+        sf_p = shape_functions(nodes, pp, **rpim)
+        up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
+        sp_ = assembly.strain(sf_p.dNdx, sf_p.dNdy, u) @ D.T
+        probes = {p.name: probe_record(p.x, p.y, up[i], sp_[i]) for i, p in enumerate(problem.probes)}
+    errors: dict = {}
+    if problem.exact is not None:
+        eq = integration_points(problem.geometry.loops(), ERROR_CELL * d_c, ERROR_CELL * d_c, ERROR_GAUSS,
+                                mode="exact")
+        sf_e = shape_functions(nodes, eq.points, **rpim)
+        u_e = np.c_[sf_e.N @ u[:, 0], sf_e.N @ u[:, 1]]
+        s_e = assembly.strain(sf_e.dNdx, sf_e.dNdy, u) @ D.T
+        errors = {**relative_errors(problem, eq.points, eq.weights, u_e, s_e),
+                  "probes": probe_errors(problem, probes)}
+    timer.lap("postprocess")
+
+    sizes = sf.support_sizes
+    return Result(
+        method="ctm-rpim", points=nodes, u=u, stress=stress,
+        cells=[("line", disc.boundary.edges)],
+        probes=probes, errors=errors,
+        counts={"nodes": len(nodes), "integration_points": len(quad.weights), "integration_lines": quad.n_lines,
+                "traction_points": len(traction_q.weights), "boundary_loops": len(disc.boundary.loops),
+                "boundary_nodes": len(boundary_nodes), "holes_filled": disc.boundary.filled_holes,
+                "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())},
+                "dofs": 2 * len(nodes), "constrained_dofs": len(fixed), "stiffness_nonzeros": int(K.nnz)},
+        timings=timer.total(),
+        parameters={**case.resolved, "derived": {
+            "d_c": d_c, "support_radius": method.support_radius * d_c,
+            "r_x": method.line_spacing[0] * d_c, "r_y": method.line_spacing[1] * d_c,
+            "alpha": method.alpha * d_c, "match_tolerance": tol,
+            "tracked_area": disc.boundary.area, "geometry_area": problem.geometry.area}},
+        defaults=case.defaults,
+    )

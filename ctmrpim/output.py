@@ -1,0 +1,86 @@
+"""Run outputs: ``summary.json`` and ``result.vtu`` (meshio), each written atomically.
+
+A file appears under its final name only once it is complete (written to a temporary name in the
+same folder, then renamed), so an interrupted run never leaves a result that looks finished.
+"""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import meshio
+import numpy as np
+
+from . import __version__
+from .result import Result
+
+
+def atomic_write(path: Path, write) -> None:
+    """Call ``write(tmp_path)`` and rename the file to ``path`` once it succeeded."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; the final file gets the usual permissions
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    atomic_write(path, lambda p: p.write_text(text))
+
+
+def _jsonable(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def summary_dict(result: Result, source: str) -> dict[str, Any]:
+    return {
+        "ctmrpim_version": __version__,
+        "source": source,
+        "method": result.method,
+        "parameters": result.parameters,
+        "defaults_applied": result.defaults,
+        "counts": result.counts,
+        "timings": result.timings,
+        "probes": result.probes,
+        "errors": result.errors,
+    }
+
+
+def write_summary(result: Result, out_dir: Path, source: str) -> Path:
+    path = Path(out_dir) / "summary.json"
+    atomic_write_text(path, json.dumps(_jsonable(summary_dict(result, source)), indent=2) + "\n")
+    return path
+
+
+def write_vtu(result: Result, out_dir: Path) -> Path:
+    """Field nodes as vertex cells with point data u and stress; boundary / elements as further cells."""
+    path = Path(out_dir) / "result.vtu"
+    n = len(result.points)
+    points = np.c_[result.points, np.zeros(n)]
+    cells = [("vertex", np.arange(n).reshape(-1, 1))] + [(k, np.asarray(v)) for k, v in result.cells]
+    mesh = meshio.Mesh(points, cells, point_data={
+        "u": np.c_[result.u, np.zeros(n)],
+        "stress": result.stress,
+    })
+    atomic_write(path, lambda p: meshio.write(p, mesh, file_format="vtu"))
+    return path
+

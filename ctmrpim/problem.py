@@ -1,0 +1,90 @@
+"""The continuous problem: geometry, material, boundary conditions, loads, probes, exact solution.
+
+A :class:`Problem` knows nothing of nodes, meshes or integration points. The CTM-RPIM solver and the
+scikit-fem reference both consume the same object. Boundary conditions select boundary points by
+``where`` expressions (``x == 0``, ``hypot(x, y) == 1 and y > 0``) in which ``==`` matches within a
+tolerance given by the discretisation (a fraction of the node spacing).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .expressions import Field
+from .geometry import Geometry
+from .material import LinearElastic
+
+
+@dataclass
+class Constraint:
+    """Prescribed displacement components on the points selected by ``where``."""
+
+    where: Field
+    ux: Field | None = None
+    uy: Field | None = None
+
+
+@dataclass
+class Traction:
+    """Surface traction (force per unit area, global x/y components) on selected boundary segments."""
+
+    where: Field
+    tx: Field | None = None
+    ty: Field | None = None
+
+
+@dataclass
+class Pressure:
+    """Normal pressure on selected boundary segments, positive pushing into the body."""
+
+    where: Field
+    p: Field
+
+
+@dataclass(frozen=True)
+class Probe:
+    name: str
+    x: float
+    y: float
+
+
+@dataclass
+class ExactSolution:
+    """Analytical fields: the L2 error needs ux and uy, the energy error all three stresses; probes
+    compare whichever components are given."""
+
+    ux: Field | None = None
+    uy: Field | None = None
+    sxx: Field | None = None
+    syy: Field | None = None
+    sxy: Field | None = None
+
+    def displacement(self, x: np.ndarray, y: np.ndarray) -> np.ndarray | None:
+        if self.ux is None or self.uy is None:
+            return None
+        return np.c_[self.ux(x, y), self.uy(x, y)]
+
+    def stress(self, x: np.ndarray, y: np.ndarray) -> np.ndarray | None:
+        if self.sxx is None or self.syy is None or self.sxy is None:
+            return None
+        return np.c_[self.sxx(x, y), self.syy(x, y), self.sxy(x, y)]
+
+
+@dataclass
+class Problem:
+    name: str
+    geometry: Geometry
+    material: LinearElastic
+    analysis: str = "linear"
+    plane: str = "stress"
+    thickness: float = 1.0
+    parameters: dict[str, float] = field(default_factory=dict)
+    constraints: list[Constraint] = field(default_factory=list)
+    tractions: list[Traction] = field(default_factory=list)
+    pressures: list[Pressure] = field(default_factory=list)
+    probes: list[Probe] = field(default_factory=list)
+    exact: ExactSolution | None = None
+
+    def D(self) -> np.ndarray:
+        return self.material.D(self.plane)

@@ -1,0 +1,306 @@
+"""TOML problem files -> :class:`Case` (a Problem plus how to discretise and solve it).
+
+Every section and key is checked: unknown keys are errors with the closest known key suggested,
+missing required keys are named, and every default that was applied is recorded so that
+``summary.json`` can echo the fully resolved input. Numbers may be written as expressions of the
+``[parameters]`` (``"W/2"``), which are themselves evaluated in file order.
+"""
+from __future__ import annotations
+
+import copy
+import difflib
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import ProblemError
+from .expressions import Field, constant
+from .geometry import Geometry, Shape
+from .material import LinearElastic
+from .method import Method
+from .nodes import NodeSpec
+from .problem import Constraint, ExactSolution, Pressure, Probe, Problem, Traction
+
+SECTIONS: dict[str, set[str] | None] = {
+    "problem": {"name", "analysis", "plane", "thickness", "description"},
+    "parameters": None,  # any names
+    "geometry": {"add", "subtract"},
+    "nodes": {"grid", "spacing", "file"},
+    "material": {"model", "E", "nu", "density"},
+    "method": set(Method.__dataclass_fields__),
+    "constraint": {"where", "ux", "uy"},
+    "traction": {"where", "tx", "ty"},
+    "pressure": {"where", "p"},
+    "probe": {"name", "at"},
+    "exact": {"ux", "uy", "sxx", "syy", "sxy"},
+}
+LIST_SECTIONS = {"constraint", "traction", "pressure", "probe"}
+REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E", "nu"],
+            "constraint": ["where"], "traction": ["where"], "pressure": ["where", "p"],
+            "probe": ["name", "at"]}
+ANALYSES = ("linear",)
+MATERIAL_MODELS = ("linear-elastic",)
+
+
+@dataclass
+class Case:
+    """One runnable configuration: the continuous problem plus its discretisation and method."""
+
+    problem: Problem
+    nodes: NodeSpec
+    method: Method
+    source: str
+    base_dir: Path
+    resolved: dict[str, Any] = field(default_factory=dict)
+    defaults: list[str] = field(default_factory=list)
+
+
+def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise ProblemError(f"cannot read problem file ({exc.strerror})", source=str(path)) from None
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ProblemError(f"malformed TOML: {exc}", source=str(path)) from None
+    try:
+        return parse_case(raw, source=str(path), base_dir=path.parent, overrides=overrides)
+    except ProblemError as exc:
+        raise exc.at(source=str(path)) from None
+
+
+def apply_overrides(raw: dict, overrides: list[str]) -> dict:
+    """``section.key=value`` settings (value in TOML syntax, else a string) applied to a raw file."""
+    raw = copy.deepcopy(raw)
+    for item in overrides:
+        if "=" not in item or "." not in item.split("=", 1)[0]:
+            raise ProblemError(f"--set {item!r}: expected section.key=value")
+        dotted, value = item.split("=", 1)
+        section, key = dotted.strip().split(".", 1)
+        if section not in SECTIONS or section in LIST_SECTIONS:
+            raise ProblemError(f"--set {item!r}: can set keys of {', '.join(s for s in SECTIONS if s not in LIST_SECTIONS)}")
+        try:
+            parsed = tomllib.loads(f"v = {value}")["v"]
+        except tomllib.TOMLDecodeError:
+            parsed = value.strip()
+        table = raw.setdefault(section, {})
+        if section == "nodes":  # grid, spacing and file exclude each other: the new one replaces
+            table.clear()
+        table[key.strip()] = parsed
+    return raw
+
+
+def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | None = None) -> Case:
+    if overrides:
+        raw = apply_overrides(raw, overrides)
+    _check_keys(raw)
+    defaults: list[str] = []
+
+    def get(section: str, key: str, default: Any) -> Any:
+        table = raw.get(section, {})
+        if key in table:
+            return table[key]
+        defaults.append(f"{section}.{key} = {default!r}")
+        return default
+
+    params = _parameters(raw.get("parameters", {}))
+
+    def num(value: Any, key: str) -> float:
+        try:
+            return constant(value, params)
+        except ProblemError as exc:
+            raise exc.at(key=key) from None
+
+    def fld(value: Any, key: str) -> Field:
+        try:
+            return Field(value, params)
+        except ProblemError as exc:
+            raise exc.at(key=key) from None
+
+    prob = raw.get("problem", {})
+    analysis = get("problem", "analysis", "linear")
+    if analysis not in ANALYSES:
+        raise ProblemError(f"analysis {analysis!r} is not supported (supported: {', '.join(ANALYSES)})",
+                           key="problem.analysis")
+    plane = get("problem", "plane", "stress")
+    if plane not in ("stress", "strain"):
+        raise ProblemError(f"plane must be 'stress' or 'strain', not {plane!r}", key="problem.plane")
+    thickness = num(get("problem", "thickness", 1.0), "problem.thickness")
+    if not thickness > 0:
+        raise ProblemError(f"thickness = {thickness} must be > 0", key="problem.thickness")
+
+    geometry = _geometry(raw.get("geometry", {}), num)
+
+    mat = raw.get("material", {})
+    if mat.get("model") not in MATERIAL_MODELS:
+        raise ProblemError(f"model {mat.get('model')!r} is not supported (supported: {', '.join(MATERIAL_MODELS)})",
+                           key="material.model")
+    material = LinearElastic(E=num(mat["E"], "material.E"), nu=num(mat["nu"], "material.nu"),
+                             density=num(get("material", "density", 0.0), "material.density"))
+
+    constraints = []
+    for i, c in enumerate(raw.get("constraint", [])):
+        if "ux" not in c and "uy" not in c:
+            raise ProblemError("give ux, uy or both", key=f"constraint[{i}]")
+        constraints.append(Constraint(where=fld(c["where"], f"constraint[{i}].where"),
+                                      ux=fld(c["ux"], f"constraint[{i}].ux") if "ux" in c else None,
+                                      uy=fld(c["uy"], f"constraint[{i}].uy") if "uy" in c else None))
+    tractions = []
+    for i, c in enumerate(raw.get("traction", [])):
+        if "tx" not in c and "ty" not in c:
+            raise ProblemError("give tx, ty or both", key=f"traction[{i}]")
+        tractions.append(Traction(where=fld(c["where"], f"traction[{i}].where"),
+                                  tx=fld(c["tx"], f"traction[{i}].tx") if "tx" in c else None,
+                                  ty=fld(c["ty"], f"traction[{i}].ty") if "ty" in c else None))
+    pressures = [Pressure(where=fld(c["where"], f"pressure[{i}].where"), p=fld(c["p"], f"pressure[{i}].p"))
+                 for i, c in enumerate(raw.get("pressure", []))]
+    probes = []
+    for i, c in enumerate(raw.get("probe", [])):
+        at = c["at"]
+        if not isinstance(at, list) or len(at) != 2:
+            raise ProblemError(f"at = {at!r} must be [x, y]", key=f"probe[{i}].at")
+        probes.append(Probe(str(c["name"]), num(at[0], f"probe[{i}].at"), num(at[1], f"probe[{i}].at")))
+    names = [p.name for p in probes]
+    if len(set(names)) != len(names):
+        raise ProblemError(f"probe names must be unique ({names})", key="probe")
+    exact = None
+    if "exact" in raw:
+        exact = ExactSolution(**{k: fld(v, f"exact.{k}") for k, v in raw["exact"].items()})
+
+    if not constraints:
+        raise ProblemError("no [[constraint]]: the body is free to move rigidly", key="constraint")
+
+    problem = Problem(name=str(prob["name"]), geometry=geometry, material=material, analysis=analysis,
+                      plane=plane, thickness=thickness, parameters=params, constraints=constraints,
+                      tractions=tractions, pressures=pressures, probes=probes, exact=exact)
+
+    nodes_raw = raw.get("nodes")
+    if not nodes_raw:
+        raise ProblemError("missing section [nodes] (grid = [nx, ny], spacing = h or file = ...)", key="nodes")
+    nodes = NodeSpec(grid=_grid(nodes_raw["grid"], num) if "grid" in nodes_raw else None,
+                     spacing=num(nodes_raw["spacing"], "nodes.spacing") if "spacing" in nodes_raw else None,
+                     file=str(nodes_raw["file"]) if "file" in nodes_raw else None)
+
+    method_raw = dict(raw.get("method", {}))
+    kwargs: dict[str, Any] = {}
+    for key, spec in Method.__dataclass_fields__.items():
+        if key not in method_raw:
+            defaults.append(f"method.{key} = {spec.default!r}")
+            continue
+        v = method_raw[key]
+        if key == "line_spacing":
+            if not isinstance(v, list) or len(v) != 2:
+                raise ProblemError(f"{v!r} must be [r_x, r_y]", key="method.line_spacing")
+            v = tuple(num(e, "method.line_spacing") for e in v)
+        elif key in ("support_radius", "eta", "alpha", "match_tolerance"):
+            v = num(v, f"method.{key}")
+        elif key == "gauss_points" and not isinstance(v, int):
+            raise ProblemError(f"{v!r} must be an integer", key="method.gauss_points")
+        kwargs[key] = v
+    method = Method(**kwargs)
+
+    resolved = {
+        "problem": {"name": problem.name, "analysis": analysis, "plane": plane, "thickness": thickness},
+        "parameters": params,
+        "geometry": {k: raw["geometry"].get(k, []) for k in ("add", "subtract")},
+        "nodes": nodes.as_dict(),
+        "material": {"model": mat["model"], "E": material.E, "nu": material.nu, "density": material.density},
+        "method": method.as_dict(),
+        "constraint": [{k: str(v) for k, v in c.items()} for c in raw.get("constraint", [])],
+        "traction": [{k: str(v) for k, v in c.items()} for c in raw.get("traction", [])],
+        "pressure": [{k: str(v) for k, v in c.items()} for c in raw.get("pressure", [])],
+        "probe": [{"name": p.name, "at": [p.x, p.y]} for p in probes],
+        "exact": {k: str(v) for k, v in raw.get("exact", {}).items()},
+    }
+    return Case(problem=problem, nodes=nodes, method=method, source=source, base_dir=base_dir,
+                resolved=resolved, defaults=defaults)
+
+
+def _grid(value: Any, num) -> tuple[int, int]:
+    if not isinstance(value, list) or len(value) != 2:
+        raise ProblemError(f"{value!r} must be [nx, ny]", key="nodes.grid")
+    n = [num(v, "nodes.grid") for v in value]
+    if not all(float(v).is_integer() for v in n):
+        raise ProblemError(f"{value!r} must be two integers", key="nodes.grid")
+    return int(n[0]), int(n[1])
+
+
+def _check_keys(raw: dict) -> None:
+    for section, value in raw.items():
+        if section not in SECTIONS:
+            raise ProblemError(f"unknown section [{section}]{_suggest(section, SECTIONS)}")
+        allowed = SECTIONS[section]
+        entries = value if section in LIST_SECTIONS else [value]
+        if section in LIST_SECTIONS and not isinstance(value, list):
+            raise ProblemError(f"write it as [[{section}]] (a list of tables)", key=section)
+        for i, entry in enumerate(entries):
+            where = f"{section}[{i}]" if section in LIST_SECTIONS else section
+            if not isinstance(entry, dict):
+                raise ProblemError(f"expected a table, got {entry!r}", key=where)
+            if allowed is not None:
+                for key in entry:
+                    if key not in allowed:
+                        raise ProblemError(f"unknown key{_suggest(key, allowed)}", key=f"{where}.{key}")
+            for key in REQUIRED.get(section, []):
+                if key not in entry:
+                    raise ProblemError("missing required key", key=f"{where}.{key}")
+    for section in ("problem", "geometry", "material"):
+        if section not in raw:
+            raise ProblemError(f"missing section [{section}]")
+
+
+def _suggest(word: str, options) -> str:
+    close = difflib.get_close_matches(word, list(options), n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def _parameters(table: dict) -> dict[str, float]:
+    params: dict[str, float] = {}
+    for name, value in table.items():
+        if not name.isidentifier():
+            raise ProblemError(f"{name!r} is not a valid name", key=f"parameters.{name}")
+        if name in ("x", "y", "t"):
+            raise ProblemError(f"{name!r} is reserved for the coordinates and time", key=f"parameters.{name}")
+        try:
+            params[name] = constant(value, params)
+        except ProblemError as exc:
+            raise exc.at(key=f"parameters.{name}") from None
+    return params
+
+
+def _geometry(table: dict, num) -> Geometry:
+    def shapes(key: str) -> list[Shape]:
+        items = table.get(key, [])
+        if not isinstance(items, list):
+            raise ProblemError("must be a list of shapes", key=f"geometry.{key}")
+        out = []
+        for i, item in enumerate(items):
+            where = f"geometry.{key}[{i}]"
+            if not isinstance(item, dict) or len(item) != 1:
+                raise ProblemError("each shape is one of {rectangle = [...]}, {polygon = [...]}, {circle = [...]}",
+                                   key=where)
+            kind, data = next(iter(item.items()))
+            try:
+                if kind in ("rectangle", "circle"):
+                    n = 4 if kind == "rectangle" else 3
+                    if not isinstance(data, list) or len(data) != n:
+                        raise ProblemError(f"{kind} needs {n} numbers")
+                    out.append(Shape(kind, tuple(num(v, where) for v in data)))
+                elif kind == "polygon":
+                    if not isinstance(data, list) or not all(isinstance(p, list) and len(p) == 2 for p in data):
+                        raise ProblemError("polygon needs a list of [x, y] vertices")
+                    out.append(Shape(kind, tuple((num(p[0], where), num(p[1], where)) for p in data)))
+                else:
+                    raise ProblemError(f"unknown shape {kind!r}{_suggest(kind, ['rectangle', 'polygon', 'circle'])}")
+                out[-1].polygon()  # validates
+            except ProblemError as exc:
+                raise exc.at(key=where) from None
+        return out
+
+    try:
+        return Geometry(add=shapes("add"), subtract=shapes("subtract"))
+    except ProblemError as exc:
+        raise exc.at(key="geometry") from None

@@ -1,0 +1,31 @@
+"""The tolerances table (``tolerances.toml``): one limit per verified quantity, read by tests and report."""
+from __future__ import annotations
+
+import tomllib
+from functools import cache
+from pathlib import Path
+
+FILE = Path(__file__).with_name("tolerances.toml")
+
+
+@cache
+def table() -> dict[str, dict]:
+    return tomllib.loads(FILE.read_text())
+
+
+def entry(key: str) -> dict:
+    return table()[key]
+
+
+def passes(key: str, value: float) -> bool:
+    e = entry(key)
+    return e.get("min", -float("inf")) <= value <= e.get("max", float("inf"))
+
+
+def describe_limit(key: str) -> str:
+    e = entry(key)
+    pct = e.get("unit") != "rate"
+    fmt = (lambda v: f"{100 * v:.3g} %") if pct else (lambda v: f"{v:.3g}")
+    if "min" in e and "max" in e:
+        return f"{fmt(e['min'])} .. {fmt(e['max'])}"
+    return f"<= {fmt(e['max'])}" if "max" in e else f">= {fmt(e['min'])}"

@@ -1,0 +1,85 @@
+"""The scikit-fem reference solver on the Timoshenko cantilever: accuracy, convergence, output shape."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ctmrpim import benchmarks
+from ctmrpim.errors import ProblemError
+from ctmrpim.nodes import make_nodes
+from ctmrpim.result import Result
+# reference_fem.solve, not reference_fem: an editable install made before reference_fem/__init__.py
+# existed maps the package as a namespace, whose __init__ is then never run
+from reference_fem.solve import solve_fem
+
+GRIDS = ((17, 5), (33, 9), (65, 17))
+L = 48.0
+
+
+@pytest.fixture(scope="module")
+def solved() -> dict[tuple[str, tuple[int, int]], Result]:
+    """Each (element, grid) solved once for the whole module (all together well under a second)."""
+    out = {}
+    for element in ("q1", "p2"):
+        for grid in GRIDS:
+            case = benchmarks.load("cantilever", overrides=[f"nodes.grid=[{grid[0]}, {grid[1]}]"])
+            out[element, grid] = solve_fem(case, element)
+    return out
+
+
+def test_q1_tip_deflection(solved) -> None:
+    res = solved["q1", (33, 9)]
+    assert res.probes["tip"]["uy"] == pytest.approx(-0.00883461, rel=1e-5)
+    assert 0.006 <= res.errors["probes"]["tip"]["uy"] <= 0.010
+
+
+def test_p2_tip_deflection(solved) -> None:
+    assert solved["p2", (33, 9)].errors["probes"]["tip"]["uy"] < 1e-4
+
+
+def test_p2_beats_q1_in_energy(solved) -> None:
+    assert solved["p2", (33, 9)].errors["energy"] < solved["q1", (33, 9)].errors["energy"]
+
+
+@pytest.mark.parametrize("norm, lo, hi", [("energy", 0.8, 1.3), ("l2", 1.6, 2.4)])
+def test_q1_convergence_rates(solved, norm: str, lo: float, hi: float) -> None:
+    h = np.array([L / (nx - 1) for nx, _ in GRIDS])
+    err = np.array([solved["q1", g].errors[norm] for g in GRIDS])
+    assert np.all(np.diff(err) < 0)
+    rate = np.polyfit(np.log(h), np.log(err), 1)[0]
+    assert lo <= rate <= hi, f"{norm} rate {rate:.3f}"
+
+
+def test_result_shape_matches_meshfree_nodes(solved) -> None:
+    res = solved["q1", (33, 9)]
+    case = benchmarks.load("cantilever", overrides=["nodes.grid=[33, 9]"])
+    nodes = make_nodes(case.problem.geometry, case.nodes, case.base_dir)
+    assert np.array_equal(res.points, nodes)  # same points, same order as the meshfree solver
+    assert res.u.shape == (len(nodes), 2) and res.stress.shape == (len(nodes), 3)
+    kind, cells = res.cells[0]
+    assert kind == "quad" and cells.shape == (32 * 8, 4)
+    assert res.counts == {"nodes": 297, "dofs": 594, "elements": 256, "integration_points": 1024}
+    assert res.method == "fem-q1" and res.parameters["element"] == "q1"
+    assert set(res.timings) == {"mesh", "assembly", "solve", "postprocess", "total"}
+    # the constrained end carries the exact displacement
+    exact = case.problem.exact
+    root = nodes[:, 0] == 0.0
+    assert np.allclose(res.u[root], exact.displacement(*nodes[root].T), rtol=0, atol=1e-15)
+
+
+def test_p1_on_a_node_cloud() -> None:
+    case = benchmarks.load("cantilever", overrides=["nodes.spacing=2.0"])
+    res = solve_fem(case, "p1")
+    assert res.cells[0][0] == "triangle"
+    assert res.errors["energy"] < 0.5 and res.errors["probes"]["tip"]["uy"] < 0.15
+
+
+def test_q1_needs_a_tensor_grid() -> None:
+    case = benchmarks.load("cantilever", overrides=["nodes.spacing=2.0"])
+    with pytest.raises(ProblemError, match="q1 needs a rectangular body and nodes.grid"):
+        solve_fem(case, "q1")
+
+
+def test_unknown_element() -> None:
+    with pytest.raises(ProblemError, match="not supported"):
+        solve_fem(benchmarks.load("cantilever"), "q2")
