@@ -70,13 +70,15 @@ def line_intervals(loops: list[np.ndarray], y: np.ndarray) -> tuple[np.ndarray, 
 
 
 def integration_points(loops: list[np.ndarray], r_x: float, r_y: float, gauss_points: int = 1,
-                       mode: str = "uniform") -> Quadrature:
+                       mode: str = "uniform", min_band: float = 0.0) -> Quadrature:
     """CTM integration points and weights over the region bounded by ``loops`` (Eqs. 22-24).
 
     ``loops`` are closed polygons (outer counter-clockwise, holes clockwise, or any orientation:
     the even-odd pairing of crossings needs none). In ``uniform`` mode bands have height about
     ``r_y`` and sub-segments length about ``r_x``; in ``exact`` mode bands also break at vertex
-    ordinates and r_x, r_y only bound the band height and sub-segment length.
+    ordinates and r_x, r_y only bound the band height and sub-segment length; vertex ordinates
+    closer than ``min_band`` to the previous break are merged (a finely sampled circle would
+    otherwise make a band per vertex), which gives up exactness only inside those thin bands.
     """
     ys = np.concatenate([lp[:, 1] for lp in loops])
     y_min, y_max = ys.min(), ys.max()
@@ -85,7 +87,12 @@ def integration_points(loops: list[np.ndarray], r_x: float, r_y: float, gauss_po
         bands = _bands(np.linspace(y_min, y_max, n_bands + 1), None)
         seg_len = r_x
     elif mode == "exact":
-        bands = _bands(np.unique(ys), r_y)
+        breaks = np.unique(ys)
+        if min_band > 0:
+            keep = np.concatenate([[True], np.diff(np.floor((breaks - breaks[0]) / min_band)) > 0])
+            keep[-1] = True
+            breaks = breaks[keep]
+        bands = _bands(breaks, r_y)
         seg_len = r_x
     else:
         raise ValueError(f"unknown CTM mode {mode!r}")

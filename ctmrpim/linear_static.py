@@ -28,6 +28,7 @@ from .rpim import shape_functions
 #: Error-norm quadrature: bands and sub-segments at most this many d_c, this many Gauss points each way.
 ERROR_CELL = 1.5
 ERROR_GAUSS = 3
+ERROR_MIN_BAND = 0.25   # merge vertex ordinates closer than this (x d_c): circles have hundreds of vertices
 #: The tracked boundary may differ from the geometry's area by this many d_c times its perimeter.
 AREA_TOLERANCE = 0.05
 
@@ -120,7 +121,7 @@ def solve_ctmrpim(case: Case) -> Result:
     errors: dict = {}
     if problem.exact is not None:
         eq = integration_points(problem.geometry.loops(), ERROR_CELL * d_c, ERROR_CELL * d_c, ERROR_GAUSS,
-                                mode="exact")
+                                mode="exact", min_band=ERROR_MIN_BAND * d_c)
         sf_e = shape_functions(nodes, eq.points, **rpim)
         u_e = np.c_[sf_e.N @ u[:, 0], sf_e.N @ u[:, 1]]
         s_e = assembly.strain(sf_e.dNdx, sf_e.dNdy, u) @ D.T
