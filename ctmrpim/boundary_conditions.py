@@ -2,14 +2,18 @@
 
 Selectors are evaluated once, on the reference configuration: constraints select boundary nodes,
 tractions and pressures select boundary segments whose two end nodes both match (so a corner node
-alone never loads the adjacent face). A selector that matches nothing is an error.
+alone never loads the adjacent face). A selector that matches nothing is an error, and so is a
+prescribed value that is not a finite number (``9**9**9`` evaluates to inf) or a part of the body
+without any constrained node (its stiffness is singular; the sparse solver does not always notice).
 """
 from __future__ import annotations
 
 import numpy as np
+import shapely
 
 from .ctm import BoundaryQuadrature, boundary_points
 from .errors import ProblemError
+from .expressions import Field
 from .problem import Problem
 
 TRACTION_GAUSS_POINTS = 3  # per boundary segment; exact for the cantilever's parabolic shear
@@ -27,10 +31,18 @@ def constrained_dofs(problem: Problem, nodes: np.ndarray, boundary_nodes: np.nda
             raise ProblemError(f"where = {c.where.text!r} selects no boundary node", key=f"constraint[{i}].where")
         for comp, f in ((0, c.ux), (1, c.uy)):
             if f is not None:
-                v = f(nodes[sel, 0], nodes[sel, 1])
+                v = _values(f, nodes[sel, 0], nodes[sel, 1], f"constraint[{i}].{'uy' if comp else 'ux'}")
                 values.update(zip((comp * n + sel).tolist(), v.tolist()))
     dofs = np.fromiter(values.keys(), int, len(values))
     vals = np.fromiter(values.values(), float, len(values))
+    parts = problem.geometry.polygons
+    if len(parts) > 1:  # one loop per part of the body, not per node
+        held = shapely.points(nodes[np.unique(dofs % n)])
+        for k, part in enumerate(parts):
+            if not (shapely.distance(part, held) <= tol).any():
+                x0, y0, x1, y1 = part.bounds
+                raise ProblemError(f"part {k + 1} of the body, within ({x0:g}, {y0:g}) .. ({x1:g}, {y1:g}), has no "
+                                   "constrained node: it is free to move rigidly", key="constraint")
     order = np.argsort(dofs)
     return dofs[order], vals[order]
 
@@ -51,10 +63,10 @@ def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol:
         px, py = q.points[:, 0], q.points[:, 1]
         if kind == "traction":
             t = problem.tractions[i]
-            tx = t.tx(px, py) if t.tx is not None else np.zeros(len(px))
-            ty = t.ty(px, py) if t.ty is not None else np.zeros(len(px))
+            tx = _values(t.tx, px, py, f"traction[{i}].tx") if t.tx is not None else np.zeros(len(px))
+            ty = _values(t.ty, px, py, f"traction[{i}].ty") if t.ty is not None else np.zeros(len(px))
         else:
-            p = problem.pressures[i].p(px, py)
+            p = _values(problem.pressures[i].p, px, py, f"pressure[{i}].p")
             tx, ty = -p * q.normals[:, 0], -p * q.normals[:, 1]
         pts.append(q.points); wts.append(q.weights); nrm.append(q.normals); tx_all.append(tx); ty_all.append(ty)
     if not pts:
@@ -62,3 +74,14 @@ def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol:
         return empty, np.zeros(0), np.zeros(0)
     q = BoundaryQuadrature(np.concatenate(pts), np.concatenate(wts), np.concatenate(nrm), np.zeros(0, int))
     return q, np.concatenate(tx_all), np.concatenate(ty_all)
+
+
+def _values(f: Field, x: np.ndarray, y: np.ndarray, key: str) -> np.ndarray:
+    """``f`` at the points; a value that is not a finite number is an error naming ``key`` and the
+    first such point (the solver would otherwise report a singular matrix, or return inf)."""
+    v = f(x, y)
+    bad = np.flatnonzero(~np.isfinite(v))
+    if len(bad):
+        j = bad[0]
+        raise ProblemError(f"{f.text!r} is {v[j]} at ({x[j]:g}, {y[j]:g}) ({len(bad)} of {len(v)} points)", key=key)
+    return v

@@ -6,6 +6,8 @@ one line on stderr naming the file, key and reason, exit status 2, no traceback,
 from __future__ import annotations
 
 import argparse
+import difflib
+import shutil
 import sys
 import warnings
 from pathlib import Path
@@ -25,7 +27,9 @@ def load_target(target: str, overrides: list[str]) -> Case:
     p = Path(target)
     if p.suffix == ".toml" or p.exists():
         return load_case(p, overrides)
-    raise ProblemError(f"{target!r} is neither a benchmark ({', '.join(benchmarks.names())}) nor a problem file")
+    close = difflib.get_close_matches(target, benchmarks.names(), n=1)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    raise ProblemError(f"{target!r} is neither a benchmark ({', '.join(benchmarks.names())}) nor a problem file{hint}")
 
 
 def solve(case: Case, solver: str, element: str) -> Result:
@@ -77,17 +81,40 @@ def _description(name: str) -> str:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .output import write_summary, write_vtu
-
     case = load_target(args.target, args.set or [])
-    result = solve(case, args.solver, args.element)
+    try:
+        result = solve(case, args.solver, args.element)
+    except ProblemError as exc:  # raised while solving, e.g. a selector that matches no node: name the file
+        raise exc.at(source=case.source) from None
     suffix = "" if args.solver == "ctm-rpim" else f"-fem-{args.element}"
     out = Path(args.out) if args.out else Path("runs") / f"{case.problem.name}{suffix}"
-    paths = [write_summary(result, out, case.source), write_vtu(result, out)]
+    paths = write_outputs(result, case, out)
     if not args.quiet:
         print(describe(result, case))
         print("  wrote " + ", ".join(str(p) for p in paths))
     return 0
+
+
+def write_outputs(result: Result, case: Case, out: Path) -> list[Path]:
+    """summary.json and result.vtu in ``out``; both or neither (a folder this call created is removed
+    again if a write fails, so a failed run never leaves a half-written result behind)."""
+    from .output import write_summary, write_vtu
+
+    created = not out.exists()
+    paths: list[Path] = []
+    try:
+        paths.append(write_summary(result, out, case.source))
+        paths.append(write_vtu(result, out))
+    except BaseException as exc:
+        for p in paths:
+            p.unlink(missing_ok=True)
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
+        if isinstance(exc, OSError):  # e.g. --out names an existing file, or a read-only folder
+            raise ProblemError(f"cannot write the results to {str(out)!r} ({exc.strerror or exc})",
+                               key="--out") from None
+        raise
+    return paths
 
 
 def cmd_report(args: argparse.Namespace) -> int:
@@ -135,8 +162,8 @@ def main(argv: list[str] | None = None) -> int:
         warnings.showwarning = show
         try:
             return args.func(args)
-        except ProblemError as exc:
-            print(f"ctmrpim: error: {exc.message}", file=sys.stderr)
+        except ProblemError as exc:  # the promised single line, even if a library's text held a newline
+            print(f"ctmrpim: error: {' '.join(exc.message.splitlines())}", file=sys.stderr)
             return 2
         except KeyboardInterrupt:
             print("ctmrpim: interrupted", file=sys.stderr)

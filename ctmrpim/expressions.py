@@ -28,6 +28,10 @@ FUNCTIONS: dict[str, Any] = {
     "floor": np.floor, "ceil": np.ceil, "sign": np.sign, "where": np.where,
     "radians": np.radians, "degrees": np.degrees,
 }
+#: Arguments each function takes. numpy ufuncs accept an extra positional ``out`` array, so
+#: ``sin(x, y)`` would overwrite the caller's y coordinates in place; ``where`` with one argument
+#: returns index arrays, not a field. Both are rejected when the expression is checked.
+ARITY: dict[str, int] = {name: f.nin for name, f in FUNCTIONS.items() if isinstance(f, np.ufunc)} | {"where": 3}
 #: Names that are always defined.
 CONSTANTS: dict[str, float] = {"pi": math.pi, "e": math.e}
 #: Coordinates and time: the free variables of a field expression.
@@ -48,12 +52,14 @@ class Expression:
         if isinstance(text, bool) or not isinstance(text, (str, int, float)):
             raise ProblemError(f"expected a number or an expression string, got {text!r}")
         self.text = str(text)
+        self.names: set[str] = set()
         try:
             self._tree = ast.parse(self.text.strip(), mode="eval").body
+            self._check(self._tree, set(allowed) | set(CONSTANTS))
         except SyntaxError as exc:
             raise ProblemError(f"expression {self.text!r} is not valid arithmetic ({exc.msg})") from None
-        self.names: set[str] = set()
-        self._check(self._tree, set(allowed) | set(CONSTANTS))
+        except (RecursionError, MemoryError):  # the parser and the checker recurse over the nesting
+            raise ProblemError(f"expression {_short(self.text)!r} is nested too deeply") from None
 
     def __repr__(self) -> str:
         return f"Expression({self.text!r})"
@@ -100,6 +106,10 @@ class Expression:
                 if isinstance(a, ast.Starred):
                     raise self._reject(a, "starred arguments are not allowed")
                 self._check(a, allowed)
+            n = ARITY[node.func.id]
+            if len(node.args) != n:
+                raise self._reject(node, f"{node.func.id} takes {n} argument{'s' if n > 1 else ''}, "
+                                         f"not {len(node.args)}")
         else:
             raise self._reject(node, f"{type(node).__name__} is not allowed, only arithmetic")
 
@@ -109,7 +119,10 @@ class Expression:
         env = dict(CONSTANTS)
         env.update(values)
         with np.errstate(all="ignore"):
-            return self._eval(self._tree, env, eq_tol)
+            try:
+                return self._eval(self._tree, env, eq_tol)
+            except RecursionError:  # checked trees just under the limit can still exceed it here
+                raise ProblemError(f"expression {_short(self.text)!r} is nested too deeply") from None
 
     def _eval(self, node: ast.AST, env: Mapping[str, Any], tol: float) -> Any:
         if isinstance(node, ast.Constant):
@@ -145,19 +158,27 @@ class Expression:
         raise AssertionError("unchecked node")  # _check admits nothing else
 
 
+def _short(text: str, limit: int = 60) -> str:
+    """The expression for a message, cut short: a pathological one may be megabytes long."""
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
 def _compare(op: ast.cmpop, a: Any, b: Any, tol: float) -> Any:
+    # every comparison tests the one rounded difference a - b, so that `a == b` is exactly
+    # `a <= b and a >= b` and `a < b` exactly `not a >= b` (comparing a with b - tol rounds differently)
+    d = np.subtract(a, b)
     if isinstance(op, ast.Eq):
-        return np.abs(np.subtract(a, b)) <= tol
+        return np.abs(d) <= tol
     if isinstance(op, ast.NotEq):
-        return np.abs(np.subtract(a, b)) > tol
+        return np.abs(d) > tol
     # inequalities honour the tolerance too: `x >= L` keeps a node at L - 1e-15, `x > 0` drops one at 1e-15
     if isinstance(op, ast.Lt):
-        return np.less(a, np.subtract(b, tol))
+        return d < -tol
     if isinstance(op, ast.LtE):
-        return np.less_equal(a, np.add(b, tol))
+        return d <= tol
     if isinstance(op, ast.Gt):
-        return np.greater(a, np.add(b, tol))
-    return np.greater_equal(a, np.subtract(b, tol))
+        return d > tol
+    return d >= -tol
 
 
 def constant(text: str | float | int, parameters: Mapping[str, float]) -> float:

@@ -46,10 +46,13 @@ class Shape:
             if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
                 raise ProblemError("a polygon needs at least three [x, y] vertices")
             poly = Polygon(pts)
-            if poly.area <= 0:
+            # collinear vertices first: a bow tie's lobes cancel to zero signed area too, but what is
+            # wrong with a bow tie is that it crosses itself, and the message should say so
+            if not poly.convex_hull.area > 0:
                 raise ProblemError(f"polygon {pts.tolist()} encloses no area")
             if not poly.is_valid:
-                raise ProblemError(f"polygon {pts.tolist()} is not simple: {explain_validity(poly)}")
+                raise ProblemError(f"polygon {pts.tolist()} is not simple, it crosses or touches itself: "
+                                   f"{explain_validity(poly)}")
             return poly
         raise ProblemError(f"unknown shape {self.kind!r}; use rectangle, polygon or circle")
 
@@ -118,11 +121,15 @@ class Geometry:
         return shapely.distance(self.region.boundary, shapely.points(points))
 
     def snap_to_circles(self, points: np.ndarray, tol: float) -> np.ndarray:
-        """Move points lying within ``tol`` of a circle's arc exactly onto it (honours true arcs)."""
+        """Move points lying within ``tol`` of a circle's arc exactly onto it (honours true arcs).
+
+        Points on the circle's polygon lie up to its sagitta inside the arc, so the tolerance is at
+        least twice that whatever ``tol`` is: with a node spacing below 1 % of the radius a tolerance
+        proportional to the spacing alone would leave them on the chords, inside a hole."""
         pts = np.array(points, dtype=float)
         for cx, cy, r in self.circles:
             d = np.hypot(pts[:, 0] - cx, pts[:, 1] - cy)
-            near = np.abs(d - r) <= tol
+            near = np.abs(d - r) <= max(tol, 2.0 * CIRCLE_SAGITTA * r)
             pts[near, 0] = cx + (pts[near, 0] - cx) * r / d[near]
             pts[near, 1] = cy + (pts[near, 1] - cy) * r / d[near]
         return pts

@@ -15,7 +15,7 @@ SOLVERS = ("superlu", "spsolve")
 def mean_node_spacing(area: float, n_nodes: int) -> float:
     """d_c = sqrt(A) / sqrt(n - 1), Eq. (36)."""
     if n_nodes < 2:
-        raise ProblemError(f"{n_nodes} node(s): need at least two to define a node spacing")
+        raise ProblemError(f"{n_nodes} node(s): need at least two to define a node spacing", key="nodes")
     return math.sqrt(area) / math.sqrt(n_nodes - 1)
 
 
@@ -36,10 +36,13 @@ class Method:
         checks = [
             ("support_radius", self.support_radius > 0, "must be > 0"),
             ("eta", self.eta > 0, "must be > 0"),
-            ("polynomial", self.polynomial in POLYNOMIAL_TERMS, f"must be one of {sorted(POLYNOMIAL_TERMS)}"),
+            ("polynomial", isinstance(self.polynomial, str) and self.polynomial in POLYNOMIAL_TERMS,
+             f"must be one of {sorted(POLYNOMIAL_TERMS)}"),  # a list there is unhashable: test the type first
             ("line_spacing", len(self.line_spacing) == 2 and min(self.line_spacing) > 0,
              "must be two positive numbers [r_x, r_y] (multiples of d_c)"),
-            ("gauss_points", isinstance(self.gauss_points, int) and 1 <= self.gauss_points <= 10,
+            # bool is an int to Python, but `gauss_points = true` is a mistake, not 1
+            ("gauss_points", isinstance(self.gauss_points, int) and not isinstance(self.gauss_points, bool)
+             and 1 <= self.gauss_points <= 10,
              "must be an integer from 1 to 10"),
             ("alpha", self.alpha > 0, "must be > 0"),
             ("boundary", self.boundary in BOUNDARIES, f"must be one of {list(BOUNDARIES)}"),

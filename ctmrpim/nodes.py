@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 import shapely
-from scipy.spatial import cKDTree
 
 from .errors import ProblemError
 from .geometry import Geometry
@@ -70,6 +69,8 @@ def _fill(geometry: Geometry, hx: float, hy: float) -> np.ndarray:
     grid = np.c_[X.ravel(), Y.ravel()]
     inside = shapely.contains_xy(geometry.region, grid[:, 0], grid[:, 1])
     grid = grid[inside]
+    from scipy.spatial import cKDTree  # here, not at the top: it is a quarter of the CLI's start-up time
+
     d, _ = cKDTree(boundary).query(grid)
     clear = (d > CLEARANCE * h) & (geometry.distance_to_boundary(grid) > CLEARANCE * h)
     nodes = np.concatenate([boundary, grid[clear]])
@@ -114,9 +115,16 @@ def _read_nodes(geometry: Geometry, path: Path) -> np.ndarray:
     if not {"x", "y"} <= set(cols):
         raise ProblemError(f"node file {str(path)!r} needs columns x and y (has {list(table.columns)})",
                            key="nodes.file")
-    nodes = table[[cols["x"], cols["y"]]].to_numpy(dtype=float)
-    if not np.all(np.isfinite(nodes)):
-        raise ProblemError(f"node file {str(path)!r} holds non-numbers", key="nodes.file")
+    # coerce rather than cast: a cell like "a" must end in the message below, not in a ValueError
+    xy = table[[cols["x"], cols["y"]]].apply(pd.to_numeric, errors="coerce")
+    nodes = xy.to_numpy(dtype=float)
+    bad = np.flatnonzero(~np.isfinite(nodes).all(axis=1))
+    if len(bad):
+        raise ProblemError(f"node file {str(path)!r} holds non-numbers, first in data row {bad[0] + 1}",
+                           key="nodes.file")
+    if len(nodes) < 3:
+        raise ProblemError(f"node file {str(path)!r} holds {len(nodes)} node(s); a body needs at least 3",
+                           key="nodes.file")
     return nodes
 
 
@@ -126,6 +134,8 @@ def check_nodes_inside(geometry: Geometry, nodes: np.ndarray, tol: float) -> Non
     if len(out):
         first = ", ".join(f"#{i} ({nodes[i, 0]:g}, {nodes[i, 1]:g})" for i in out[:5])
         raise ProblemError(f"{len(out)} node(s) lie outside the geometry: {first}", key="nodes")
+    from scipy.spatial import cKDTree
+
     d, _ = cKDTree(nodes).query(nodes, k=2)
     same = np.flatnonzero(d[:, 1] <= 1e-9 * math.sqrt(geometry.area))
     if len(same):

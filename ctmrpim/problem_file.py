@@ -9,14 +9,17 @@ from __future__ import annotations
 
 import copy
 import difflib
+import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from .errors import ProblemError
 from .expressions import Field, constant
-from .geometry import Geometry, Shape
+from .geometry import CIRCLE_SAGITTA, Geometry, Shape
 from .material import LinearElastic
 from .method import Method
 from .nodes import NodeSpec
@@ -39,6 +42,9 @@ LIST_SECTIONS = {"constraint", "traction", "pressure", "probe"}
 REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E", "nu"],
             "constraint": ["where"], "traction": ["where"], "pressure": ["where", "p"],
             "probe": ["name", "at"]}
+#: Names people reach for instead of the file's keys, to suggest where difflib finds no close spelling.
+SYNONYMS = {"youngs": "E", "young": "E", "youngs_modulus": "E", "young_modulus": "E", "modulus": "E",
+            "poisson": "nu", "poissons_ratio": "nu", "poisson_ratio": "nu", "rho": "density"}
 ANALYSES = ("linear",)
 MATERIAL_MODELS = ("linear-elastic",)
 
@@ -76,20 +82,22 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
     """``section.key=value`` settings (value in TOML syntax, else a string) applied to a raw file."""
     raw = copy.deepcopy(raw)
     for item in overrides:
-        if "=" not in item or "." not in item.split("=", 1)[0]:
+        dotted, eq, value = item.partition("=")
+        section, dot, key = (part.strip() for part in dotted.partition("."))
+        if not (eq and dot and section and key):  # `method.=3` would otherwise set a key named ''
             raise ProblemError(f"--set {item!r}: expected section.key=value")
-        dotted, value = item.split("=", 1)
-        section, key = dotted.strip().split(".", 1)
         if section not in SECTIONS or section in LIST_SECTIONS:
             raise ProblemError(f"--set {item!r}: can set keys of {', '.join(s for s in SECTIONS if s not in LIST_SECTIONS)}")
         try:
             parsed = tomllib.loads(f"v = {value}")["v"]
-        except tomllib.TOMLDecodeError:
+        except tomllib.TOMLDecodeError as exc:
+            if value.strip()[:1] in ("[", "{", '"', "'"):  # meant as TOML: a string fallback would hide the typo
+                raise ProblemError(f"--set {item!r}: the value is not valid TOML ({exc})") from None
             parsed = value.strip()
         table = raw.setdefault(section, {})
         if section == "nodes":  # grid, spacing and file exclude each other: the new one replaces
             table.clear()
-        table[key.strip()] = parsed
+        table[key] = parsed
     return raw
 
 
@@ -121,6 +129,10 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
             raise exc.at(key=key) from None
 
     prob = raw.get("problem", {})
+    if not isinstance(prob["name"], str) or not prob["name"].strip() or any(c in prob["name"] for c in "/\\"):
+        # the name is the default output folder runs/NAME: it must be one plain folder name
+        raise ProblemError(f"name = {prob['name']!r} must be a non-empty string without / or \\",
+                           key="problem.name")
     analysis = get("problem", "analysis", "linear")
     if analysis not in ANALYSES:
         raise ProblemError(f"analysis {analysis!r} is not supported (supported: {', '.join(ANALYSES)})",
@@ -158,11 +170,18 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     pressures = [Pressure(where=fld(c["where"], f"pressure[{i}].where"), p=fld(c["p"], f"pressure[{i}].p"))
                  for i, c in enumerate(raw.get("pressure", []))]
     probes = []
+    # a probe on a true arc lies up to the sagitta outside the circle's polygon
+    probe_tol = (1e-9 * math.sqrt(geometry.area)
+                 + 2.0 * CIRCLE_SAGITTA * max((c[2] for c in geometry.circles), default=0.0))
     for i, c in enumerate(raw.get("probe", [])):
         at = c["at"]
         if not isinstance(at, list) or len(at) != 2:
             raise ProblemError(f"at = {at!r} must be [x, y]", key=f"probe[{i}].at")
-        probes.append(Probe(str(c["name"]), num(at[0], f"probe[{i}].at"), num(at[1], f"probe[{i}].at")))
+        probe = Probe(str(c["name"]), num(at[0], f"probe[{i}].at"), num(at[1], f"probe[{i}].at"))
+        # checked here, where the key is known: outside the body RPIM would fail later naming only a point
+        if geometry.distance_outside(np.array([[probe.x, probe.y]]))[0] > probe_tol:
+            raise ProblemError(f"({probe.x:g}, {probe.y:g}) lies outside the geometry", key=f"probe[{i}].at")
+        probes.append(probe)
     names = [p.name for p in probes]
     if len(set(names)) != len(names):
         raise ProblemError(f"probe names must be unique ({names})", key="probe")
@@ -197,7 +216,7 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
             v = tuple(num(e, "method.line_spacing") for e in v)
         elif key in ("support_radius", "eta", "alpha", "match_tolerance"):
             v = num(v, f"method.{key}")
-        elif key == "gauss_points" and not isinstance(v, int):
+        elif key == "gauss_points" and (isinstance(v, bool) or not isinstance(v, int)):
             raise ProblemError(f"{v!r} must be an integer", key="method.gauss_points")
         kwargs[key] = v
     method = Method(**kwargs)
@@ -205,7 +224,9 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     resolved = {
         "problem": {"name": problem.name, "analysis": analysis, "plane": plane, "thickness": thickness},
         "parameters": params,
-        "geometry": {k: raw["geometry"].get(k, []) for k in ("add", "subtract")},
+        # the shapes with their expressions evaluated ("-W/2" -> -6.0), as the solver saw them
+        "geometry": {k: [{sh.kind: [list(v) if isinstance(v, tuple) else v for v in sh.data]} for sh in shapes]
+                     for k, shapes in (("add", geometry.add), ("subtract", geometry.subtract))},
         "nodes": nodes.as_dict(),
         "material": {"model": mat["model"], "E": material.E, "nu": material.nu, "density": material.density},
         "method": method.as_dict(),
@@ -253,7 +274,16 @@ def _check_keys(raw: dict) -> None:
 
 
 def _suggest(word: str, options) -> str:
-    close = difflib.get_close_matches(word, list(options), n=1)
+    """`` (did you mean 'x'?)`` for the closest option: a known synonym (``youngs`` -> ``E``), a
+    different capitalisation (``e`` -> ``E``), or the closest spelling."""
+    options = list(options)
+    lower = {o.lower(): o for o in options}
+    if SYNONYMS.get(word.lower()) in options:
+        close = [SYNONYMS[word.lower()]]
+    elif word.lower() in lower:
+        close = [lower[word.lower()]]
+    else:
+        close = difflib.get_close_matches(word, options, n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 

@@ -117,20 +117,23 @@ def _chunk(nodes, pts, point_ids, tree, k, radius, eta, m, scale, derivatives):
     local *= vf[..., None]
     c = len(pts)
     size = k + m
-    G = np.zeros((c, size, size))
+    G = np.empty((c, size, size))
+    G[:, k:, k:] = 0.0
     R0 = G[:, :k, :k]
+    lx, ly = local[..., 0], local[..., 1]
+    r2 = lx[:, :, None] - lx[:, None, :]
+    r2 *= r2
+    dy = ly[:, :, None] - ly[:, None, :]
+    dy *= dy
+    r2 += dy
+    R0[...] = _powr(r2, eta)
+    # chunks hold points of similar support size, so padding is rare: clear only the padded rows/columns
+    pc, pi = np.nonzero(~valid)
+    if len(pc):
+        R0[pc, pi, :] = 0.0
+        R0[pc, :, pi] = 0.0
+        R0[pc, pi, pi] = 1.0                                      # padding slots: identity, decoupled
     sq = np.einsum("cid,cid->ci", local, local)
-    # |a - b|^2 = |a|^2 + |b|^2 - 2 a.b: one batched matmul instead of a (c, k, k, 2) difference array
-    R0[...] = np.matmul(local, local.transpose(0, 2, 1))
-    R0 *= -2.0
-    R0 += sq[:, :, None]
-    R0 += sq[:, None, :]
-    np.maximum(R0, 0.0, out=R0)
-    R0[...] = _powr(R0, eta)
-    R0 *= vf[:, :, None]
-    R0 *= vf[:, None, :]
-    ii = np.arange(k)
-    R0[:, ii, ii] = 1.0 - vf                                      # padding slots: identity, decoupled
     P0 = _polynomial(local[..., 0], local[..., 1], m) * vf[..., None]
     G[:, :k, k:] = P0
     G[:, k:, :k] = P0.transpose(0, 2, 1)

@@ -1,0 +1,235 @@
+"""Problem files: the cantilever benchmark, --set overrides, defaults, geometry and node placement."""
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from ctmrpim import benchmarks
+from ctmrpim.errors import ProblemError
+from ctmrpim.geometry import CIRCLE_SAGITTA, Geometry, Shape, circle_segments
+from ctmrpim.method import Method
+from ctmrpim.nodes import NodeSpec, check_nodes_inside, make_nodes
+from ctmrpim.problem_file import apply_overrides, load_case
+
+MINIMAL = """
+[problem]
+name = "plate"
+
+[geometry]
+add = [{ rectangle = [0, 0, 10, 2] }]
+
+[nodes]
+grid = [11, 3]
+
+[material]
+model = "linear-elastic"
+E = 1000.0
+nu = 0.25
+
+[[constraint]]
+where = "x == 0"
+ux = "0"
+"""
+
+
+def write(tmp_path: Path, text: str, name: str = "p.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_cantilever_benchmark() -> None:
+    case = benchmarks.load("cantilever")
+    p = case.problem
+    assert p.name == "cantilever" and p.analysis == "linear" and p.plane == "stress" and p.thickness == 1.0
+    assert p.parameters == {"P": -1000.0, "E": 3.0e7, "nu": 0.3, "L": 48.0, "W": 12.0, "I": 144.0}
+    assert (p.material.E, p.material.nu, p.material.density) == (3.0e7, 0.3, 1.0)
+    assert p.geometry.bounds == (0.0, -6.0, 48.0, 6.0) and p.geometry.is_rectangle()
+    assert p.geometry.area == 576.0
+    assert case.nodes == NodeSpec(grid=(33, 9))
+    assert case.method == Method(support_radius=4.0, eta=5.0, polynomial="linear", line_spacing=(1 / 3, 1 / 3),
+                                 gauss_points=1, alpha=1.5)
+    assert [(q.name, q.x, q.y) for q in p.probes] == [("tip", 48.0, 0.0), ("root_top", 0.0, 6.0)]
+    assert len(p.constraints) == 1 and len(p.tractions) == 1 and not p.pressures
+    # the traction is the exact parabolic shear, the constraint the exact displacement (Eq. 35)
+    y = np.linspace(-6, 6, 7)
+    np.testing.assert_allclose(p.tractions[0].ty(np.full(7, 48.0), y), -1000 / 288 * (36 - y**2), rtol=1e-14)
+    np.testing.assert_allclose(p.constraints[0].uy(np.zeros(7), y), p.exact.uy(np.zeros(7), y), rtol=0, atol=0)
+    assert p.constraints[0].where(np.array([0.0, 0.01, 1.0]), np.zeros(3), eq_tol=0.02).tolist() == [True, True, False]
+    assert case.resolved["parameters"]["I"] == 144.0
+    assert case.resolved["geometry"] == {"add": [{"rectangle": [0.0, -6.0, 48.0, 6.0]}], "subtract": []}
+    assert case.resolved["method"]["line_spacing"] == [1 / 3, 1 / 3]
+
+
+def test_overrides() -> None:
+    raw = tomllib.loads(benchmarks.path("cantilever").read_text())
+    new = apply_overrides(raw, ["nodes.grid=[65, 17]", "method.eta=5.5", "method.polynomial=quadratic",
+                                "parameters.P=-2000", 'problem.plane="strain"'])
+    assert raw["nodes"] == {"grid": [33, 9]} and raw["method"]["eta"] == 5.0   # the input is not touched
+    assert new["nodes"] == {"grid": [65, 17]}
+    assert new["method"]["eta"] == 5.5 and new["method"]["polynomial"] == "quadratic"
+    assert new["parameters"]["P"] == -2000 and new["problem"]["plane"] == "strain"
+    # grid, spacing and file exclude each other: a new one replaces the old
+    assert apply_overrides(raw, ["nodes.spacing=2.0"])["nodes"] == {"spacing": 2.0}
+    assert apply_overrides({"nodes": {"spacing": 1.0}}, ["nodes.grid=[17,5]"])["nodes"] == {"grid": [17, 5]}
+
+    case = benchmarks.load("cantilever", ["nodes.grid=[17,5]", "parameters.P=-2000", "method.eta=5.5"])
+    assert case.nodes == NodeSpec(grid=(17, 5)) and case.method.eta == 5.5
+    # parameters are evaluated after the override: I depends on W, the traction on P
+    assert case.problem.parameters["P"] == -2000.0
+    assert case.problem.tractions[0].ty(np.array([48.0]), np.array([0.0]))[0] == pytest.approx(-2000 / 288 * 36)
+    spaced = benchmarks.load("cantilever", ["nodes.spacing=3"])
+    assert spaced.nodes == NodeSpec(spacing=3.0) and spaced.resolved["nodes"] == {"spacing": 3.0}
+
+
+@pytest.mark.parametrize("item, match", [
+    ("nodes.grid", "expected section.key=value"),
+    ("grid=[17,5]", "expected section.key=value"),
+    ("method.=3", "expected section.key=value"),
+    (".eta=3", "expected section.key=value"),
+    ("constraint.where=1", "can set keys of"),
+    ("foo.bar=1", "can set keys of"),
+    ("nodes.grid=[17,5", "not valid TOML"),
+])
+def test_bad_overrides(item: str, match: str) -> None:
+    with pytest.raises(ProblemError, match=match) as info:
+        benchmarks.load("cantilever", [item])
+    assert info.value.source.endswith("cantilever.toml")
+
+
+def test_override_unknown_key_suggests() -> None:
+    with pytest.raises(ProblemError, match=r"did you mean 'support_radius'\?") as info:
+        benchmarks.load("cantilever", ["method.supprt_radius=3"])
+    assert info.value.key == "method.supprt_radius"
+
+
+def test_defaults_are_recorded(tmp_path: Path) -> None:
+    case = load_case(write(tmp_path, MINIMAL))
+    assert set(case.defaults) == {
+        "problem.analysis = 'linear'", "problem.plane = 'stress'", "problem.thickness = 1.0",
+        "material.density = 0.0",
+        *(f"method.{k} = {v.default!r}" for k, v in Method.__dataclass_fields__.items())}
+    assert case.method == Method()
+    assert case.resolved["problem"] == {"name": "plate", "analysis": "linear", "plane": "stress", "thickness": 1.0}
+    assert case.resolved["material"]["density"] == 0.0
+    given = load_case(write(tmp_path, MINIMAL + "\n[method]\neta = 3.0\n"))
+    assert "method.eta = 5.0" not in given.defaults and given.method.eta == 3.0
+
+
+def test_parameters_are_evaluated_in_order(tmp_path: Path) -> None:
+    text = MINIMAL.replace("[geometry]", '[parameters]\na = 2\nb = "3*a"\nc = "hypot(a, b) - sqrt(40)"\n\n[geometry]')
+    text = text.replace("rectangle = [0, 0, 10, 2]", 'rectangle = [0, 0, "b + 4", "a"]')
+    case = load_case(write(tmp_path, text))
+    assert case.problem.parameters == {"a": 2.0, "b": 6.0, "c": pytest.approx(0.0, abs=1e-14)}
+    assert case.problem.geometry.bounds == (0.0, 0.0, 10.0, 2.0)
+
+
+# -- geometry -----------------------------------------------------------------------------------------
+def test_circle_polygon_sagitta() -> None:
+    cx, cy, r = 1.0, -2.0, 3.0
+    poly = Shape("circle", (cx, cy, r)).polygon()
+    v = np.asarray(poly.exterior.coords)[:-1]
+    assert len(v) == circle_segments()
+    np.testing.assert_allclose(np.hypot(v[:, 0] - cx, v[:, 1] - cy), r, rtol=1e-14)   # vertices on the arc
+    mid = 0.5 * (v + np.roll(v, -1, axis=0))
+    sagitta = r - np.hypot(mid[:, 0] - cx, mid[:, 1] - cy)       # chord midpoint to arc
+    assert sagitta.max() <= CIRCLE_SAGITTA * r
+    assert sagitta.max() > 0.5 * CIRCLE_SAGITTA * r             # and not needlessly fine
+
+
+def test_rectangle_minus_circle_area() -> None:
+    a, b, r = 10.0, 8.0, 1.0
+    g = Geometry(add=[Shape("rectangle", (0.0, 0.0, a, b))], subtract=[Shape("circle", (4.0, 3.0, r))])
+    exact = a * b - math.pi * r**2
+    # the polygon misses (4/3) pi r^2 CIRCLE_SAGITTA of the hole at most (segments of height <= sagitta)
+    assert 0 <= g.area - exact <= 4 / 3 * math.pi * r**2 * CIRCLE_SAGITTA
+    assert g.area == pytest.approx(exact, rel=1e-6)
+    assert len(g.loops()) == 2 and g.circles == [(4.0, 3.0, r)] and not g.is_rectangle()
+
+
+def test_add_and_subtract() -> None:
+    # an L shape from two overlapping rectangles, a triangle notch cut from it
+    g = Geometry(add=[Shape("rectangle", (0, 0, 4, 1)), Shape("rectangle", (0, 0, 1, 3))],
+                 subtract=[Shape("polygon", ((3, 0), (4, 0), (4, 1)))])
+    assert g.area == pytest.approx(4 + 2 - 0.5, rel=1e-15)
+    assert g.bounds == (0.0, 0.0, 4.0, 3.0) and len(g.loops()) == 1
+    # two separate parts stay two parts
+    two = Geometry(add=[Shape("rectangle", (0, 0, 1, 1)), Shape("rectangle", (2, 0, 3, 1))])
+    assert len(two.polygons) == 2 and two.area == 2.0
+
+
+def test_boundary_loops_keep_the_body_on_the_left() -> None:
+    g = Geometry(add=[Shape("rectangle", (0, 0, 4, 4))], subtract=[Shape("circle", (2, 2, 1))])
+    outer, hole = g.loops()
+
+    def signed_area(p: np.ndarray) -> float:
+        return 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
+    assert signed_area(outer) == pytest.approx(16.0) and signed_area(hole) < 0
+
+
+# -- nodes ----------------------------------------------------------------------------------------------
+def test_grid_on_a_rectangle_is_the_tensor_grid() -> None:
+    case = benchmarks.load("cantilever", ["nodes.grid=[17,5]"])
+    nodes = make_nodes(case.problem.geometry, case.nodes)
+    assert nodes.shape == (85, 2)
+    assert np.unique(nodes[:, 0]).tolist() == np.linspace(0, 48, 17).tolist()
+    assert np.unique(nodes[:, 1]).tolist() == np.linspace(-6, 6, 5).tolist()
+
+
+@pytest.mark.parametrize("h", [0.5, 0.25])
+def test_spacing_on_a_plate_with_a_hole(h: float) -> None:
+    r = 1.0
+    g = Geometry(add=[Shape("rectangle", (-4.0, -4.0, 4.0, 4.0))], subtract=[Shape("circle", (0.0, 0.0, r))])
+    nodes = make_nodes(g, NodeSpec(spacing=h))
+    assert np.all(g.distance_outside(nodes) == 0.0)          # inside the body or on its boundary
+    check_nodes_inside(g, nodes, tol=1e-12)                  # and no two coincide
+    d = np.hypot(nodes[:, 0], nodes[:, 1])
+    on_hole = d < r + 0.1 * h
+    assert abs(on_hole.sum() - 2 * math.pi * r / h) <= 1
+    assert np.abs(d[on_hole] - r).max() < 1e-12 * r          # exactly on the true arc, not on a chord
+    # the interior grid keeps clear of the boundary nodes: no clumps
+    gap, _ = cKDTree(nodes).query(nodes, k=2)
+    assert gap[:, 1].min() > 0.4 * h
+    assert len(nodes) > g.area / h**2
+
+
+def test_boundary_nodes_on_a_large_arc_lie_on_it() -> None:
+    """A spacing far below the radius: the sagitta (1e-5 r), not the spacing, bounds how far off the
+    arc the polygon's points are, and the snapping must reach that far (it once used 1e-3 h)."""
+    r, h = 1.0, 0.002
+    g = Geometry(add=[Shape("rectangle", (0.0, 0.0, 0.1, 0.1))], subtract=[Shape("circle", (1.05, 0.05, r))])
+    nodes = make_nodes(g, NodeSpec(spacing=h))
+    d = np.hypot(nodes[:, 0] - 1.05, nodes[:, 1] - 0.05)
+    on_arc = d < r + 0.1 * h
+    assert on_arc.sum() > 40
+    assert np.abs(d[on_arc] - r).max() < 1e-12 * r
+
+
+def test_nodes_from_csv(tmp_path: Path) -> None:
+    X, Y = np.meshgrid(np.linspace(0, 10, 6), np.linspace(0, 2, 3))
+    rows = "\n".join(f"{float(x)!r}, {float(y)!r}" for x, y in zip(X.ravel(), Y.ravel()))
+    (tmp_path / "cloud.csv").write_text("x, y\n" + rows)
+    text = MINIMAL.replace("grid = [11, 3]", 'file = "cloud.csv"')
+    case = load_case(write(tmp_path, text))      # the CSV path is relative to the problem file
+    assert case.nodes == NodeSpec(file="cloud.csv") and case.base_dir == tmp_path
+    nodes = make_nodes(case.problem.geometry, case.nodes, case.base_dir)
+    np.testing.assert_array_equal(nodes, np.c_[X.ravel(), Y.ravel()])
+
+
+@pytest.mark.parametrize("content, match", [
+    ("x,y\n0,0\n1,a\n2,2\n", "holds non-numbers, first in data row 2"),
+    ("a,b\n0,0\n1,1\n2,2\n", "needs columns x and y"),
+    ("x,y\n0,0\n1,1\n", "holds 2 node"),
+    ("", "cannot read node file"),
+])
+def test_bad_csv(tmp_path: Path, content: str, match: str) -> None:
+    (tmp_path / "cloud.csv").write_text(content)
+    case = load_case(write(tmp_path, MINIMAL.replace("grid = [11, 3]", 'file = "cloud.csv"')))
+    with pytest.raises(ProblemError, match=match) as info:
+        make_nodes(case.problem.geometry, case.nodes, case.base_dir)
+    assert info.value.key == "nodes.file"
