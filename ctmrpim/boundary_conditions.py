@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from .assembly import dof
 from .ctm import BoundaryQuadrature, boundary_points
 from .errors import ProblemError
 from .expressions import Field
@@ -21,7 +22,8 @@ TRACTION_GAUSS_POINTS = 3  # per boundary segment; exact for the cantilever's pa
 
 def constrained_dofs(problem: Problem, nodes: np.ndarray, boundary_nodes: np.ndarray,
                      tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """Fixed dofs (blocked order) and their values; a later constraint overrides an earlier one."""
+    """Fixed dofs (interleaved: 2 node + component) and their values; a later constraint overrides an
+    earlier one."""
     n = len(nodes)
     values: dict[int, float] = {}
     bx, by = nodes[boundary_nodes, 0], nodes[boundary_nodes, 1]
@@ -32,12 +34,12 @@ def constrained_dofs(problem: Problem, nodes: np.ndarray, boundary_nodes: np.nda
         for comp, f in ((0, c.ux), (1, c.uy)):
             if f is not None:
                 v = _values(f, nodes[sel, 0], nodes[sel, 1], f"constraint[{i}].{'uy' if comp else 'ux'}")
-                values.update(zip((comp * n + sel).tolist(), v.tolist()))
+                values.update(zip(dof(sel, comp).tolist(), v.tolist()))
     dofs = np.fromiter(values.keys(), int, len(values))
     vals = np.fromiter(values.values(), float, len(values))
     parts = problem.geometry.polygons
     if len(parts) > 1:  # one loop per part of the body, not per node
-        held = shapely.points(nodes[np.unique(dofs % n)])
+        held = shapely.points(nodes[np.unique(dofs // 2)])
         for k, part in enumerate(parts):
             if not (shapely.distance(part, held) <= tol).any():
                 x0, y0, x1, y1 = part.bounds

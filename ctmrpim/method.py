@@ -9,7 +9,7 @@ from .errors import ProblemError
 
 POLYNOMIAL_TERMS = {"linear": 3, "quadratic": 6}
 BOUNDARIES = ("alpha", "geometry")
-SOLVERS = ("superlu", "spsolve")
+SOLVERS = ("auto", "banded", "superlu", "spsolve")
 
 
 def mean_node_spacing(area: float, n_nodes: int) -> float:
@@ -28,7 +28,7 @@ class Method:
     gauss_points: int = 1                # Gauss points per sub-segment and per band
     alpha: float = 1.5                   # alpha-shape radius / d_c
     boundary: str = "alpha"              # integrate over the tracked alpha shape, or the exact geometry
-    solver: str = "superlu"              # sparse direct solver for the linear system
+    solver: str = "auto"                 # linear solver: auto, banded (RCM + Cholesky), superlu, spsolve
     match_tolerance: float = 0.01        # '==' tolerance in `where` selectors / d_c
 
     def __post_init__(self) -> None:

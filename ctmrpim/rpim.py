@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
+from threadpoolctl import threadpool_limits
 
 from .errors import ProblemError
 
@@ -45,6 +46,17 @@ def _powr(r2: np.ndarray, p: float) -> np.ndarray:
             out *= r2
         return out
     return np.power(r2, 0.5 * p)
+
+
+def _powr_inplace(r2: np.ndarray, p: float, work: np.ndarray) -> None:
+    """r2 <- r^p, using ``work`` (same shape) as scratch."""
+    if float(p).is_integer() and p >= 1 and int(p) % 2 == 1:
+        np.sqrt(r2, out=work)
+        for _ in range((int(p) - 1) // 2):
+            work *= r2
+        r2[...] = work
+    else:
+        np.power(r2, 0.5 * p, out=r2)
 
 
 def _polynomial(x: np.ndarray, y: np.ndarray, m: int) -> np.ndarray:
@@ -84,7 +96,8 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
         return _chunk(nodes, points[sel], sel, tree, int(counts[sel].max()), support_radius, eta, m, scale,
                       derivatives)
 
-    with ThreadPoolExecutor(max_workers=THREADS) as pool:
+    # each small LAPACK solve runs on one thread; BLAS threads on top of ours would only contend
+    with threadpool_limits(limits=1, user_api="blas"), ThreadPoolExecutor(max_workers=THREADS) as pool:
         parts = list(pool.map(work, bounds))
     shape = (len(points), len(nodes))
     if parts:
@@ -121,12 +134,13 @@ def _chunk(nodes, pts, point_ids, tree, k, radius, eta, m, scale, derivatives):
     G[:, k:, k:] = 0.0
     R0 = G[:, :k, :k]
     lx, ly = local[..., 0], local[..., 1]
-    r2 = lx[:, :, None] - lx[:, None, :]
-    r2 *= r2
+    # r^2 and r^eta built in place in G: fewer large temporaries, fewer fresh pages to fault in
+    np.subtract(lx[:, :, None], lx[:, None, :], out=R0)
+    np.multiply(R0, R0, out=R0)
     dy = ly[:, :, None] - ly[:, None, :]
     dy *= dy
-    r2 += dy
-    R0[...] = _powr(r2, eta)
+    R0 += dy
+    _powr_inplace(R0, eta, work=dy)
     # chunks hold points of similar support size, so padding is rare: clear only the padded rows/columns
     pc, pi = np.nonzero(~valid)
     if len(pc):
