@@ -13,12 +13,12 @@ import argparse
 import time
 import tracemalloc
 
-import numpy as np
 import pandas as pd
 
 from ctmrpim import benchmarks
 from ctmrpim.linear_static import solve_ctmrpim
 from reference_fem import solve_fem
+from studies.fitting import fitted_rate
 
 DEFAULT_GRIDS = "17x5,33x9,65x17,129x33,257x65"
 
@@ -68,7 +68,7 @@ def main() -> None:
         if len(d) < 2:
             continue
         cols = [c for c in d.columns if c.startswith("t_") and d[c].notna().all() and (d[c] > 0).all()]
-        fits = {c[2:]: np.polyfit(np.log(d.n), np.log(d[c]), 1)[0] for c in cols}
+        fits = {c[2:]: fitted_rate(d.n, d[c]) for c in cols}
         print(f"  {method:9s} " + "  ".join(f"{k} {v:.2f}" for k, v in fits.items()))
     print("\nCTM-RPIM / FEM Q1 at equal n (total time; tip error):")
     piv = df.pivot(index="grid", columns="method", values=["t_total", "tip_error"])

@@ -24,7 +24,6 @@ def constrained_dofs(problem: Problem, nodes: np.ndarray, boundary_nodes: np.nda
                      tol: float) -> tuple[np.ndarray, np.ndarray]:
     """Fixed dofs (interleaved: 2 node + component) and their values; a later constraint overrides an
     earlier one."""
-    n = len(nodes)
     values: dict[int, float] = {}
     bx, by = nodes[boundary_nodes, 0], nodes[boundary_nodes, 1]
     for i, c in enumerate(problem.constraints):

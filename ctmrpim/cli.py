@@ -16,9 +16,7 @@ from . import benchmarks
 from .errors import ProblemError
 from .problem_file import Case, load_case
 from .result import Result
-
-ELEMENTS = ("q1", "p1", "p2")
-
+from .solvers import ELEMENTS, METHODS, solve
 
 def load_target(target: str, overrides: list[str]) -> Case:
     """A benchmark name or a path to a problem file."""
@@ -30,14 +28,6 @@ def load_target(target: str, overrides: list[str]) -> Case:
     close = difflib.get_close_matches(target, benchmarks.names(), n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise ProblemError(f"{target!r} is neither a benchmark ({', '.join(benchmarks.names())}) nor a problem file{hint}")
-
-
-def solve(case: Case, solver: str, element: str) -> Result:
-    if solver == "fem":
-        from reference_fem import solve_fem
-        return solve_fem(case, element)
-    from .linear_static import solve_ctmrpim
-    return solve_ctmrpim(case)
 
 
 def describe(result: Result, case: Case) -> str:
@@ -134,7 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="output folder (default runs/NAME)")
     p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE",
                    help="override a problem-file value, e.g. --set nodes.grid=[65,17] (repeatable)")
-    p.add_argument("--solver", choices=("ctm-rpim", "fem"), default="ctm-rpim")
+    p.add_argument("--solver", choices=METHODS, default="ctm-rpim")
     p.add_argument("--element", choices=ELEMENTS, default="q1", help="FEM element (with --solver fem)")
     p.add_argument("--quiet", action="store_true", help="print nothing on success")
     p.set_defaults(func=cmd_run)

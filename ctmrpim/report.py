@@ -1,8 +1,7 @@
 """The verification report: ``reports/REPORT.md`` with its tables (CSV) and figures (PNG).
 
-For now it covers the linear cantilever (paper Section 3.1): CTM-RPIM against the analytical
-solution and scikit-fem Q1, P1 and P2 on the same node grids, with every checked number's pass/fail
-against the tolerances table.
+It runs the studies (``studies/``), checks every verified number against the tolerances table and
+writes the side-by-side comparison: analytical reference, CTM-RPIM, scikit-fem, pass/fail.
 """
 from __future__ import annotations
 
@@ -10,60 +9,13 @@ import datetime as _dt
 import io
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from . import benchmarks, tolerances
-from .output import atomic_write, atomic_write_text
+from studies import cantilever_convergence, plate_hole_convergence
+from studies.fitting import fitted_rate
 
-QUICK_GRIDS = [(17, 5), (33, 9), (65, 17)]
-FULL_GRIDS = QUICK_GRIDS + [(129, 33), (257, 65)]
-METHODS = [("ctm-rpim", None), ("fem", "q1"), ("fem", "p1"), ("fem", "p2")]
-
-
-def cantilever_convergence(grids: list[tuple[int, int]], progress=print) -> pd.DataFrame:
-    from .cli import solve
-
-    rows = []
-    for nx, ny in grids:
-        case = benchmarks.load("cantilever", [f"nodes.grid=[{nx}, {ny}]"])
-        for solver, element in METHODS:
-            r = solve(case, solver, element)
-            rows.append({"grid": f"{nx} x {ny}", "nodes": r.counts["nodes"], "h": 48.0 / (nx - 1),
-                         "method": r.method, "integration_points": r.counts["integration_points"],
-                         "tip_error": r.errors["probes"]["tip"]["uy"], "l2_error": r.errors["l2"],
-                         "energy_error": r.errors["energy"], "time_s": r.timings["total"]})
-            progress(f"  cantilever {nx:>3} x {ny:<3} {r.method:9s} tip error {100 * rows[-1]['tip_error']:9.4f} %"
-                     f"  energy {100 * rows[-1]['energy_error']:8.4f} %  {rows[-1]['time_s']:7.3f} s")
-    return pd.DataFrame(rows)
-
-
-PLATE_QUICK = [0.5, 0.25]
-PLATE_FULL = [0.5, 0.25, 0.125, 0.0625]
-PLATE_METHODS = [("ctm-rpim", None), ("fem", "p1"), ("fem", "p2")]
-
-
-def plate_hole_convergence(spacings: list[float], progress=print) -> pd.DataFrame:
-    from .cli import solve
-
-    rows = []
-    for plane, ps in (("stress", 1), ("strain", 0)):
-        for h in spacings:
-            case = benchmarks.load("plate-hole", [f"nodes.spacing={h}", f'problem.plane="{plane}"', f"parameters.ps={ps}"])
-            for solver, element in PLATE_METHODS:
-                r = solve(case, solver, element)
-                top = r.probes["hole_top"]
-                rows.append({"plane": plane, "spacing": h, "nodes": r.counts["nodes"], "method": r.method,
-                             "l2_error": r.errors["l2"], "energy_error": r.errors["energy"],
-                             "sxx_hole_top": top["sxx"], "time_s": r.timings["total"]})
-                progress(f"  plate-hole plane {plane:6s} h = {h:<6g} {r.method:9s} L2 {100 * r.errors['l2']:8.4f} %"
-                         f"  energy {100 * r.errors['energy']:8.4f} %  sxx(0, a) = {top['sxx']:8.1f} (exact 3000)")
-    return pd.DataFrame(rows)
-
-
-def fitted_rate(h: np.ndarray, err: np.ndarray) -> float:
-    return float(np.polyfit(np.log(h), np.log(err), 1)[0])
-
+from . import tolerances
+from .output import atomic_write_text
 
 def checks(df: pd.DataFrame, plate: pd.DataFrame) -> pd.DataFrame:
     def value(method: str, grid: str, col: str) -> float:
@@ -99,35 +51,11 @@ def checks(df: pd.DataFrame, plate: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def convergence_figure(df: pd.DataFrame, path: Path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    for method, d in df.groupby("method", sort=False):
-        axes[0].loglog(d.nodes, d.tip_error, "o-", label=method)
-        axes[1].loglog(d.nodes, d.energy_error, "o-", label=method)
-    axes[0].set(xlabel="nodes", ylabel="relative tip-deflection error", title="Cantilever: tip error (cf. Fig. 9b)")
-    axes[1].set(xlabel="nodes", ylabel="relative energy-norm error", title="Cantilever: energy-norm error")
-    for ax in axes:
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
-    fig.tight_layout()
-    atomic_write(path, lambda p: fig.savefig(p, format="png", dpi=120))
-    plt.close(fig)
-
-
 def make_report(quick: bool = True, out_dir: Path = Path("reports"), progress=print) -> Path:
     out_dir = Path(out_dir)
-    grids = QUICK_GRIDS if quick else FULL_GRIDS
-    progress(f"cantilever convergence ({'quick' if quick else 'full'}): {len(grids)} grids x {len(METHODS)} methods")
-    df = cantilever_convergence(grids, progress)
-    plate = plate_hole_convergence(PLATE_QUICK if quick else PLATE_FULL, progress)
+    df = cantilever_convergence.run(quick, out_dir, progress)
+    plate = plate_hole_convergence.run(quick, out_dir, progress)
     chk = checks(df, plate)
-    atomic_write_text(out_dir / "plate_hole_convergence.csv", plate.to_csv(index=False))
-    atomic_write_text(out_dir / "cantilever_convergence.csv", df.to_csv(index=False))
-    convergence_figure(df, out_dir / "cantilever_convergence.png")
 
     table = df.assign(tip_error=lambda d: d.tip_error.map(lambda v: f"{100 * v:.4g} %"),
                       l2_error=lambda d: d.l2_error.map(lambda v: f"{100 * v:.4g} %"),
@@ -141,7 +69,7 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), progress=pr
     buf.write(f"Generated by `ctmrpim report {'--quick' if quick else '--full'}` on "
               f"{_dt.date.today().isoformat()}. Every number below was computed by that command.\n\n")
     buf.write("## Checks against the tolerances table\n\n")
-    buf.write(chk.to_markdown(index=False) if _has_tabulate() else chk.to_string(index=False))
+    buf.write(chk.to_markdown(index=False))
     n_fail = int((chk["pass"] == "FAIL").sum())
     buf.write(f"\n\n{len(chk) - n_fail} of {len(chk)} checks pass.\n\n")
     buf.write("## Cantilever (paper Section 3.1, Table 1, Eq. 35)\n\n")
@@ -149,7 +77,7 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), progress=pr
               "per sub-segment, linear augmentation), not the r_c = 2 d_c / two-point setting printed beside the "
               "paper's Fig. 9, which gives 1-1.8 % at 33 x 9. scikit-fem on the same node grids: Q1 quadrilaterals, "
               "P1 and P2 triangles (each grid cell split in two).\n\n")
-    buf.write(table.to_markdown(index=False) if _has_tabulate() else table.to_string(index=False))
+    buf.write(table.to_markdown(index=False))
     buf.write("\n\n![convergence](cantilever_convergence.png)\n\n")
     buf.write(f"At 33 x 9 nodes CTM-RPIM's tip error is {ratio_q1:.1f} times smaller than Q1's (the paper's claim "
               f"holds), but P2 triangles on the same grid are {ratio_p2:.0f} times more accurate than CTM-RPIM, "
@@ -162,7 +90,7 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), progress=pr
                           energy_error=lambda d: d.energy_error.map(lambda v: f"{100 * v:.4g} %"),
                           sxx_hole_top=lambda d: d.sxx_hole_top.map(lambda v: f"{v:.0f}"),
                           time_s=lambda d: d.time_s.map(lambda v: f"{v:.3f}"))
-    buf.write(ptable.to_markdown(index=False) if _has_tabulate() else ptable.to_string(index=False))
+    buf.write(ptable.to_markdown(index=False))
     buf.write("\n\nWhere CTM-RPIM is weak: the stress concentration sxx = 3T at (0, a), read at the boundary node, "
               "does not converge with the paper's integration (one Gauss point, r = d_c/3): about 4450 at spacing "
               "0.125 and 5000 at 0.0625 against 3000, because the single-point line integration under-resolves "
@@ -173,10 +101,3 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), progress=pr
     progress("\n" + chk[["check", "ours", "limit", "pass"]].to_string(index=False))
     return path
 
-
-def _has_tabulate() -> bool:
-    try:
-        import tabulate  # noqa: F401  (pandas' to_markdown needs it)
-        return True
-    except ImportError:
-        return False

@@ -2,21 +2,11 @@
 from __future__ import annotations
 
 import pytest
+from verify import check
 
-from ctmrpim import benchmarks, tolerances
 from ctmrpim.linear_static import solve_ctmrpim
 from reference_fem import solve_fem
-
-PLANES = {"stress": 1, "strain": 0}
-
-
-def case(plane: str, spacing: float):
-    return benchmarks.load("plate-hole", [f"nodes.spacing={spacing}", f'problem.plane="{plane}"',
-                                          f"parameters.ps={PLANES[plane]}"])
-
-
-def check(key: str, value: float) -> None:
-    assert tolerances.passes(key, value), f"{key}: {value:.6g} outside {tolerances.describe_limit(key)}"
+from studies.plate_hole_convergence import PLANES, case
 
 
 @pytest.fixture(scope="module", params=sorted(PLANES))

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from verify import check, check_rate
 
 from ctmrpim import benchmarks, tolerances
 from ctmrpim.errors import ProblemError
@@ -13,10 +14,6 @@ from reference_fem import solve_fem
 GRIDS = ((17, 5), (33, 9), (65, 17))
 L = 48.0
 
-
-def check(key: str, value: float) -> None:
-    """``value`` within the limits of ``key`` in the tolerances table (the only place limits live)."""
-    assert tolerances.passes(key, value), f"{key}: {value:.6g} outside {tolerances.describe_limit(key)}"
 
 
 @pytest.fixture(scope="module")
@@ -48,10 +45,7 @@ def test_p2_beats_q1_in_energy(solved) -> None:
 @pytest.mark.parametrize("norm", ["energy", "l2"])
 def test_q1_convergence_rates(solved, norm: str) -> None:
     h = np.array([L / (nx - 1) for nx, _ in GRIDS])
-    err = np.array([solved["q1", g].errors[norm] for g in GRIDS])
-    assert np.all(np.diff(err) < 0)
-    rate = np.polyfit(np.log(h), np.log(err), 1)[0]
-    check(f"fem-q1-{norm}-rate", rate)
+    check_rate(f"fem-q1-{norm}-rate", h, [solved["q1", g].errors[norm] for g in GRIDS])
 
 
 def test_result_shape_matches_meshfree_nodes(solved) -> None:
