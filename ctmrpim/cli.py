@@ -107,11 +107,43 @@ def write_outputs(result: Result, case: Case, out: Path) -> list[Path]:
     return paths
 
 
+def _sweep(args: argparse.Namespace):
+    from studies.base import CACHE
+
+    from .sweep import Sweep
+    if args.workers < 1:
+        raise ProblemError(f"--workers {args.workers}: need at least 1")
+    return Sweep(CACHE, workers=args.workers, scheduler=args.scheduler, retry_failed=args.retry_failed)
+
+
+def cmd_study(args: argparse.Namespace) -> int:
+    import studies
+
+    names = studies.NAMES if args.name == "all" else [args.name]
+    for name in names:
+        if studies.ALIASES.get(name, name) not in studies.NAMES:
+            close = difflib.get_close_matches(name, list(studies.ALIASES), n=1)
+            raise ProblemError(f"unknown study {name!r}{f' (did you mean {close[0]!r}?)' if close else ''}; "
+                               f"available: {', '.join(studies.ALIASES)} or all")
+    sweep = _sweep(args)
+    for name in names:
+        df = studies.study(name).run(args.quick, Path(args.out), sweep)
+        print(df.drop(columns=[c for c in ("status",) if c in df]).to_string(index=False))
+    return 0
+
+
 def cmd_report(args: argparse.Namespace) -> int:
     from .report import make_report
-    path = make_report(quick=not args.full, out_dir=Path(args.out))
+    path = make_report(quick=not args.full, out_dir=Path(args.out), sweep=_sweep(args))
     print(f"wrote {path}")
     return 0
+
+
+def _sweep_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", default="reports", help="folder for tables and figures (default reports/)")
+    p.add_argument("--workers", type=int, default=1, help="local worker processes for the sweeps (default 1)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run the sweeps on this Dask scheduler instead")
+    p.add_argument("--retry-failed", action="store_true", help="recompute cases that failed before")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -128,11 +160,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--element", choices=ELEMENTS, default="q1", help="FEM element (with --solver fem)")
     p.add_argument("--quiet", action="store_true", help="print nothing on success")
     p.set_defaults(func=cmd_run)
+    p = sub.add_parser("study", help="run a parameter study (tables and figures under reports/)")
+    p.add_argument("name", help="study name, or all: node-density, integration-density, support-radius, "
+                                "shape-parameter, parameter-map, time-to-accuracy, plate-hole-convergence")
+    p.add_argument("--quick", action="store_true", help="the small version CI runs")
+    _sweep_options(p)
+    p.set_defaults(func=cmd_study)
     p = sub.add_parser("report", help="regenerate the verification report")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="quick mode (default)")
-    g.add_argument("--full", action="store_true", help="paper resolution")
-    p.add_argument("--out", default="reports", help="report folder (default reports/)")
+    g.add_argument("--full", action="store_true", help="every study at the paper's resolution")
+    _sweep_options(p)
     p.set_defaults(func=cmd_report)
     return ap
 

@@ -22,9 +22,14 @@ def passes(key: str, value: float) -> bool:
     return e.get("min", -float("inf")) <= value <= e.get("max", float("inf"))
 
 
+def is_dimensionless(key: str) -> bool:
+    """Rates and ratios are shown as plain numbers, relative errors in percent."""
+    return entry(key).get("unit") in ("rate", "ratio")
+
+
 def describe_limit(key: str) -> str:
     e = entry(key)
-    pct = e.get("unit") != "rate"
+    pct = not is_dimensionless(key)
     fmt = (lambda v: f"{100 * v:.3g} %") if pct else (lambda v: f"{v:.3g}")
     if "min" in e and "max" in e:
         return f"{fmt(e['min'])} .. {fmt(e['max'])}"

@@ -1,8 +1,18 @@
-"""Parameter studies and paper reproductions. Each study runs alone
-(``python -m studies.NAME [--quick] [--out DIR]``), writes its table (CSV) and figure (PNG) under
-``reports/``, and returns its table to the report:
-
-* ``cantilever_convergence``: the cantilever of Section 3.1 at growing node density (cf. Fig. 9),
-  CTM-RPIM against scikit-fem Q1, P1 and P2 on the same node grids;
-* ``plate_hole_convergence``: the Kirsch plate with a hole, plane stress and plane strain.
+"""Parameter studies and paper reproductions. Each runs alone (``python -m studies.NAME [--quick]``
+or ``ctmrpim study NAME [--quick]``), sends its cases through the sweep executor (cached under
+``runs/sweeps/``, resumable, parallel with ``--workers`` or on Dask with ``--scheduler``), and writes
+``reports/NAME.csv`` and ``reports/NAME.png``.
 """
+from __future__ import annotations
+
+from importlib import import_module
+from types import ModuleType
+
+NAMES = ["node_density", "integration_density", "support_radius", "shape_parameter", "parameter_map",
+         "time_to_accuracy", "plate_hole_convergence"]
+#: command-line spelling (dashes) -> module name
+ALIASES = {n.replace("_", "-"): n for n in NAMES}
+
+
+def study(name: str) -> ModuleType:
+    return import_module(f"studies.{ALIASES.get(name, name)}")

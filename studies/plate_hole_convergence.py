@@ -1,50 +1,65 @@
 """Plate with a circular hole (Kirsch), quarter model, plane stress and plane strain: CTM-RPIM
 against scikit-fem P1 and P2 on the same nodes; L2 and energy-norm errors and the stress
-concentration sxx(0, a) (exact 3 T).
-
-Writes ``plate_hole_convergence.csv``.
+concentration sxx(0, a) (exact 3 T) read at the boundary node.
 """
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import pandas as pd
 
 from ctmrpim import benchmarks
-from ctmrpim.output import atomic_write_text
-from ctmrpim.solvers import solve
+from ctmrpim.problem_file import Case
+from ctmrpim.sweep import CaseSpec
 
+from .base import new_figure, run_study
+
+NAME = "plate_hole_convergence"
+TITLE = "Plate with a hole (Kirsch)"
 QUICK_SPACINGS = [0.5, 0.25]
 FULL_SPACINGS = [0.5, 0.25, 0.125, 0.0625]
-METHODS = [("ctm-rpim", None), ("fem", "p1"), ("fem", "p2")]
+METHODS = [("ctm-rpim", "q1"), ("fem", "p1"), ("fem", "p2")]
 PLANES = {"stress": 1, "strain": 0}   # the problem file's `ps` parameter must follow problem.plane
 
 
-def case(plane: str, spacing: float):
-    return benchmarks.load("plate-hole", [f"nodes.spacing={spacing}", f'problem.plane="{plane}"',
-                                          f"parameters.ps={PLANES[plane]}"])
+def overrides(plane: str, spacing: float) -> tuple[str, ...]:
+    return (f"nodes.spacing={spacing}", f'problem.plane="{plane}"', f"parameters.ps={PLANES[plane]}")
 
 
-def run(quick: bool = True, out_dir: Path = Path("reports"), progress=print) -> pd.DataFrame:
-    spacings = QUICK_SPACINGS if quick else FULL_SPACINGS
-    progress(f"plate with hole ({'quick' if quick else 'full'}): spacings {spacings}, plane stress and strain")
-    rows = []
-    for plane in PLANES:
-        for h in spacings:
-            c = case(plane, h)
-            for solver, element in METHODS:
-                r = solve(c, solver, element)
-                top = r.probes["hole_top"]
-                rows.append({"plane": plane, "spacing": h, "nodes": r.counts["nodes"], "method": r.method,
-                             "l2_error": r.errors["l2"], "energy_error": r.errors["energy"],
-                             "sxx_hole_top": top["sxx"], "time_s": r.timings["total"]})
-                progress(f"  plate-hole plane {plane:6s} h = {h:<6g} {r.method:9s} L2 {100 * r.errors['l2']:8.4f} %"
-                         f"  energy {100 * r.errors['energy']:8.4f} %  sxx(0, a) = {top['sxx']:8.1f} (exact 3000)")
-    df = pd.DataFrame(rows)
-    atomic_write_text(Path(out_dir) / "plate_hole_convergence.csv", df.to_csv(index=False))
-    return df
+def case(plane: str, spacing: float) -> Case:
+    return benchmarks.load("plate-hole", list(overrides(plane, spacing)))
+
+
+def specs(quick: bool) -> list[CaseSpec]:
+    return [CaseSpec("plate-hole", overrides(plane, h), solver, element, labels=(("plane", plane), ("spacing", h)))
+            for plane in PLANES for h in (QUICK_SPACINGS if quick else FULL_SPACINGS) for solver, element in METHODS]
+
+
+def extra(summary: dict) -> dict:
+    return {"sxx_hole_top": summary["probes"]["hole_top"]["sxx"]}
+
+
+def figure(df: pd.DataFrame):
+    fig, axes = new_figure(2)
+    for (method, plane), d in df[df.status == "ok"].groupby(["method", "plane"], sort=False):
+        axes[0, 0].loglog(d.nodes, d.energy_error, "o-" if plane == "stress" else "s--", label=f"{method}, plane {plane}")
+        axes[0, 1].semilogx(d.nodes, d.sxx_hole_top / 1000.0, "o-" if plane == "stress" else "s--",
+                            label=f"{method}, plane {plane}")
+    axes[0, 1].axhline(3.0, color="k", lw=0.8, label="exact 3 T")
+    axes[0, 0].set(xlabel="nodes", ylabel="relative energy-norm error", title=TITLE + ": energy error")
+    axes[0, 1].set(xlabel="nodes", ylabel="sxx(0, a) / T", title="Stress concentration at the hole")
+    for ax in axes[0]:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
+    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
 
 
 if __name__ == "__main__":
-    from studies.cli import main
+    from .cli import main
     main(run, __doc__)

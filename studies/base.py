@@ -1,0 +1,72 @@
+"""What every study shares: run its cases through the sweep executor, tabulate, write CSV and PNG.
+
+A study module defines ``NAME``, ``TITLE``, ``specs(quick) -> list[CaseSpec]`` (each spec labelled
+with the study's coordinates), ``figure(table) -> Figure`` and optionally ``extra(summary) -> dict``
+for columns of its own; :func:`run_study` does the rest.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import pandas as pd
+
+from ctmrpim.output import atomic_write, atomic_write_text
+from ctmrpim.sweep import CaseOutcome, CaseSpec, Sweep
+
+CACHE = Path("runs") / "sweeps"   # one folder per case, named by the hash of its resolved input
+
+
+def method_name(spec: CaseSpec) -> str:
+    if spec.solver == "fem":
+        return f"fem-{spec.element}"
+    quadratic = any(o.replace(" ", "") == 'method.polynomial="quadratic"' for o in spec.overrides)
+    return "ctm-rpim-quadratic" if quadratic else "ctm-rpim"
+
+
+def metrics(outcome: CaseOutcome, extra=None) -> dict[str, Any]:
+    """The numbers a study tabulates from one case's summary.json (plus ``extra(summary)``)."""
+    row: dict[str, Any] = {**outcome.spec.label_dict(), "method": method_name(outcome.spec),
+                           "status": outcome.status}
+    s = outcome.summary
+    if s is None:
+        return {**row, "error_message": outcome.error}
+    errors = s.get("errors", {})
+    tip = errors.get("probes", {}).get("tip", {})
+    derived = s["parameters"].get("derived", {})
+    row.update(nodes=s["counts"]["nodes"], integration_points=s["counts"]["integration_points"],
+               d_c=derived.get("d_c", s["parameters"].get("d_c")),
+               tip_error=tip.get("uy"), l2_error=errors.get("l2"), energy_error=errors.get("energy"),
+               time_s=s["timings"]["total"])
+    if extra is not None:
+        row.update(extra(s))
+    return row
+
+
+def run_study(module: ModuleType, quick: bool = True, out_dir: Path = Path("reports"),
+              sweep: Sweep | None = None, progress=print) -> pd.DataFrame:
+    sweep = sweep or Sweep(CACHE)
+    specs = module.specs(quick)
+    progress(f"study {module.NAME} ({'quick' if quick else 'full'}): {len(specs)} cases")
+    outcomes = sweep.run(specs, desc=module.NAME)
+    df = pd.DataFrame([metrics(o, getattr(module, "extra", None)) for o in outcomes])
+    failed = df[df.status != "ok"]
+    for _, r in failed.iterrows():
+        progress(f"  case failed: {r.to_dict()}")
+    progress(f"  {len(specs) - sweep.computed} cached, {sweep.computed} computed, {len(failed)} failed")
+    out_dir = Path(out_dir)
+    atomic_write_text(out_dir / f"{module.NAME}.csv", df.to_csv(index=False))
+    fig = module.figure(df)
+    atomic_write(out_dir / f"{module.NAME}.png", lambda p: fig.savefig(p, format="png", dpi=110))
+    import matplotlib.pyplot as plt
+    plt.close(fig)
+    return df
+
+
+def new_figure(ncols: int = 1, width: float = 5.5):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(1, ncols, figsize=(width * ncols, 4), squeeze=False)

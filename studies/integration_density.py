@@ -1,0 +1,42 @@
+"""Integration density (paper Fig. 10): d_c/r from 1.0 to 5.0 step 0.5 with r_x = r_y = r,
+17 x 5 and 33 x 9 nodes, support radius 4 d_c, eta = 5, one Gauss point per sub-segment. The paper
+claims the error falls roughly exponentially in d_c/r and is satisfactory from d_c/r = 3.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from ctmrpim.sweep import CaseSpec
+
+from .base import run_study
+from .one_parameter import cantilever_specs, error_plot
+
+NAME = "integration_density"
+TITLE = "Integration density (cf. Fig. 10)"
+PARAMETER = "dc_over_r"
+QUICK = [1.0, 2.0, 3.0, 4.0, 5.0]
+FULL = [1.0 + 0.5 * i for i in range(9)]
+QUICK_GRIDS = [(17, 5), (33, 9)]
+FULL_GRIDS = [(17, 5), (33, 9)]
+PAPER_RANGE = (3.0, 5.0)
+
+
+def specs(quick: bool) -> list[CaseSpec]:
+    return cantilever_specs(PARAMETER, QUICK if quick else FULL, QUICK_GRIDS if quick else FULL_GRIDS,
+                            lambda q: (f"method.line_spacing=[{1 / q!r}, {1 / q!r}]",))
+
+
+def figure(df: pd.DataFrame):
+    return error_plot(df, PARAMETER, "d_c / r", TITLE, PAPER_RANGE)
+
+
+def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
+    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
+
+
+if __name__ == "__main__":
+    from .cli import main
+    main(run, __doc__)

@@ -1,0 +1,31 @@
+"""Shared pieces of the one-parameter studies of Figs. 10-12: cases and the error-against-parameter plot."""
+from __future__ import annotations
+
+import pandas as pd
+
+from ctmrpim.sweep import CaseSpec
+
+from .base import new_figure
+
+
+def cantilever_specs(parameter: str, values: list[float], grids: list[tuple[int, int]],
+                     override) -> list[CaseSpec]:
+    """CTM-RPIM cantilever cases, one per (grid, value); ``override(value)`` gives the --set strings."""
+    return [CaseSpec("cantilever", (f"nodes.grid=[{nx}, {ny}]", *override(v)),
+                     labels=((parameter, v), ("grid", f"{nx} x {ny}")))
+            for nx, ny in grids for v in values]
+
+
+def error_plot(df: pd.DataFrame, parameter: str, xlabel: str, title: str, band: tuple[float, float] | None = None):
+    fig, axes = new_figure(1, 6.5)
+    ax = axes[0, 0]
+    for grid, d in df[df.status == "ok"].groupby("grid", sort=False):
+        ax.semilogy(d[parameter], 100 * d.tip_error, "o-", label=f"tip error, {grid}")
+        ax.semilogy(d[parameter], 100 * d.energy_error, "s--", alpha=0.6, label=f"energy error, {grid}")
+    if band:
+        ax.axvspan(*band, color="green", alpha=0.1, label="paper's recommended range")
+    ax.set(xlabel=xlabel, ylabel="relative error [%]", title=title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig

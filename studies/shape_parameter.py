@@ -1,0 +1,41 @@
+"""Shape parameter (paper Fig. 12): eta from 1.5 to 10.5 step 1.0, 17 x 5 nodes, r = d_c/3,
+r_c = 4 d_c. The paper claims eta in [3.5, 9.5] is accurate and [4.5, 7.5] low and stable.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from ctmrpim.sweep import CaseSpec
+
+from .base import run_study
+from .one_parameter import cantilever_specs, error_plot
+
+NAME = "shape_parameter"
+TITLE = "Shape parameter (cf. Fig. 12)"
+PARAMETER = "eta"
+QUICK = [1.5, 3.5, 4.5, 5.5, 6.5, 7.5, 9.5]
+FULL = [1.5 + 1.0 * i for i in range(10)]
+QUICK_GRIDS = [(17, 5)]
+FULL_GRIDS = [(17, 5)]
+PAPER_RANGE = (4.5, 7.5)
+
+
+def specs(quick: bool) -> list[CaseSpec]:
+    return cantilever_specs(PARAMETER, QUICK if quick else FULL, QUICK_GRIDS if quick else FULL_GRIDS,
+                            lambda v: (f"method.eta={v!r}",))
+
+
+def figure(df: pd.DataFrame):
+    return error_plot(df, PARAMETER, "eta", TITLE, PAPER_RANGE)
+
+
+def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
+    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
+
+
+if __name__ == "__main__":
+    from .cli import main
+    main(run, __doc__)

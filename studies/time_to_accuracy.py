@@ -1,0 +1,76 @@
+"""Time to accuracy: cantilever tip error against wall time for CTM-RPIM and scikit-fem Q1, P1 and P2
+over a range of node grids (a Pareto plot), and the time each method needs to reach 1 %, 0.1 % and
+0.01 % tip error, interpolated in log-log between the grids that bracket it. Every case runs on one
+core (the sweep executor's workers), so the times compare.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ctmrpim.sweep import CaseSpec
+
+from .base import new_figure, run_study
+
+NAME = "time_to_accuracy"
+TITLE = "Time to accuracy (cantilever tip error)"
+TARGETS = (1e-2, 1e-3, 1e-4)
+GRIDS = {  # (quick, full) node grids per method; FEM is cheap, so it goes finer
+    ("ctm-rpim", "q1"): ([(17, 5), (33, 9), (65, 17)], [(17, 5), (33, 9), (65, 17), (129, 33), (257, 65)]),
+    ("fem", "q1"): ([(17, 5), (33, 9), (65, 17), (129, 33)],
+                    [(17, 5), (33, 9), (65, 17), (129, 33), (257, 65), (513, 129)]),
+    ("fem", "p1"): ([(33, 9), (65, 17), (129, 33)], [(33, 9), (65, 17), (129, 33), (257, 65), (513, 129)]),
+    ("fem", "p2"): ([(9, 3), (17, 5), (33, 9)], [(9, 3), (17, 5), (33, 9), (65, 17)]),
+}
+
+
+def specs(quick: bool) -> list[CaseSpec]:
+    return [CaseSpec("cantilever", (f"nodes.grid=[{nx}, {ny}]",), solver, element, labels=(("grid", f"{nx} x {ny}"),))
+            for (solver, element), grids in GRIDS.items() for nx, ny in grids[0 if quick else 1]]
+
+
+def time_to_reach(d: pd.DataFrame, target: float) -> float:
+    """Wall time at which the tip error reaches ``target`` (log-log interpolation), NaN if never."""
+    d = d.sort_values("time_s")
+    t, e = np.log(d.time_s.to_numpy()), np.log(d.tip_error.to_numpy())
+    for i in range(len(e)):
+        if e[i] <= np.log(target):
+            if i == 0:
+                return float(np.exp(t[0]))
+            f = (np.log(target) - e[i - 1]) / (e[i] - e[i - 1])
+            return float(np.exp(t[i - 1] + f * (t[i] - t[i - 1])))
+    return float("nan")
+
+
+def targets_table(df: pd.DataFrame) -> pd.DataFrame:
+    ok = df[df.status == "ok"]
+    rows = [{"method": m, **{f"time_to_{100 * x:g}%": time_to_reach(d, x) for x in TARGETS}}
+            for m, d in ok.groupby("method", sort=False)]
+    return pd.DataFrame(rows)
+
+
+def figure(df: pd.DataFrame):
+    fig, axes = new_figure(1, 6.5)
+    ax = axes[0, 0]
+    for method, d in df[df.status == "ok"].groupby("method", sort=False):
+        d = d.sort_values("time_s")
+        ax.loglog(d.time_s, 100 * d.tip_error, "o-", label=method)
+    for x in TARGETS:
+        ax.axhline(100 * x, color="grey", lw=0.8, ls=":")
+    ax.set(xlabel="wall time per solve, one core [s]", ylabel="tip error [%]", title=TITLE)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
+    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
+
+
+if __name__ == "__main__":
+    from .cli import main
+    main(run, __doc__)

@@ -1,0 +1,45 @@
+"""Every study's quick mode, run through the sweep executor, checked against the tolerances table."""
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+from verify import check
+
+import studies
+from ctmrpim.sweep import Sweep
+from studies import claims
+
+
+@pytest.fixture(scope="module")
+def tables(tmp_path_factory) -> dict[str, pd.DataFrame]:
+    root = tmp_path_factory.mktemp("studies")
+    sweep = Sweep(root / "cache", workers=2, progress=False)
+    return {name: studies.study(name).run(True, root / "reports", sweep, progress=lambda *_: None)
+            for name in studies.NAMES}
+
+
+def test_every_case_succeeds(tables) -> None:
+    for name, df in tables.items():
+        assert (df.status == "ok").all(), f"{name}: {df[df.status != 'ok'].to_dict('records')}"
+
+
+@pytest.mark.parametrize("key", sorted(claims.CLAIMS))
+def test_paper_claim(tables, key: str) -> None:
+    values = claims.evaluate(tables)
+    check(key, values[key])
+
+
+def test_outputs_written(tables, tmp_path_factory) -> None:
+    reports = next(p for p in tmp_path_factory.getbasetemp().rglob("reports") if p.is_dir())
+    for name in studies.NAMES:
+        assert (reports / f"{name}.csv").stat().st_size > 0
+        assert (reports / f"{name}.png").read_bytes()[:4] == b"\x89PNG"
+        assert len(pd.read_csv(reports / f"{name}.csv")) == len(tables[name])
+
+
+def test_time_to_accuracy_targets(tables) -> None:
+    from studies.time_to_accuracy import targets_table
+
+    t = targets_table(tables["time_to_accuracy"]).set_index("method")
+    assert t.loc["fem-p2", "time_to_0.1%"] > 0
+    assert t.loc["ctm-rpim", "time_to_1%"] > 0

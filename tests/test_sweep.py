@@ -1,0 +1,74 @@
+"""The sweep executor: caching by resolved input, resume, failures, local processes against Dask."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from ctmrpim.sweep import CaseSpec, Sweep, case_hash
+
+SPECS = [CaseSpec("cantilever", ("nodes.grid=[17, 5]", f"method.eta={eta}"), labels=(("eta", eta),))
+         for eta in (3.5, 5.0, 6.5)] + [CaseSpec("cantilever", ("nodes.grid=[17, 5]",), "fem", "q1")]
+BAD = CaseSpec("cantilever", ("nodes.grid=[17, 5]", "method.support_radius=0.5"))
+
+
+def numbers(outcomes) -> list:
+    return [(o.status, o.summary and o.summary["probes"], o.summary and o.summary["errors"]) for o in outcomes]
+
+
+def test_hash_follows_the_resolved_input() -> None:
+    a = case_hash(CaseSpec("cantilever"))
+    assert a == case_hash(CaseSpec("cantilever", ("nodes.grid=[33, 9]",)))   # the default, spelt out
+    assert a != case_hash(CaseSpec("cantilever", ("method.eta=5.5",)))
+    assert a != case_hash(CaseSpec("cantilever", (), "fem", "q1"))
+
+
+def test_resume_computes_only_what_is_missing(tmp_path) -> None:
+    first = Sweep(tmp_path, progress=False)
+    first.run(SPECS[:2])                       # an "interrupted" sweep: two cases done
+    assert first.computed == 2
+    mtimes = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("summary.json")}
+    again = Sweep(tmp_path, progress=False)
+    out = again.run(SPECS)
+    assert again.computed == 2 and [o.cached for o in out] == [True, True, False, False]
+    assert {p: p.stat().st_mtime_ns for p in mtimes} == mtimes   # the finished cases were not redone
+    # a case whose status record is missing (killed while writing) counts as not done
+    (out[3].folder / "status.json").unlink()
+    third = Sweep(tmp_path, progress=False)
+    third.run(SPECS)
+    assert third.computed == 1
+
+
+def test_failed_case_keeps_its_error_and_is_retried_on_request(tmp_path) -> None:
+    out = Sweep(tmp_path, progress=False).run([BAD])
+    assert out[0].status == "error" and "support radius" in out[0].error
+    status = json.loads((out[0].folder / "status.json").read_text())
+    assert status["status"] == "error" and status["end"] >= status["start"]
+    again = Sweep(tmp_path, progress=False)
+    again.run([BAD])
+    assert again.computed == 0
+    retry = Sweep(tmp_path, progress=False, retry_failed=True)
+    retry.run([BAD])
+    assert retry.computed == 1
+
+
+def test_processes_and_in_process_agree(tmp_path) -> None:
+    serial = Sweep(tmp_path / "a", progress=False).run(SPECS)
+    parallel = Sweep(tmp_path / "b", workers=2, progress=False).run(SPECS)
+    assert numbers(serial) == numbers(parallel)
+
+
+def test_dask_local_cluster_gives_identical_results(tmp_path) -> None:
+    from dask import distributed  # a test dependency: never skipped
+    local = Sweep(tmp_path / "local", workers=2, progress=False).run(SPECS)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        remote = Sweep(tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False).run(SPECS)
+    assert numbers(local) == numbers(remote)
+
+
+def test_unreachable_scheduler_is_a_clear_error(tmp_path) -> None:
+    from ctmrpim.errors import ProblemError
+
+    with pytest.raises(ProblemError, match="Dask scheduler"):
+        Sweep(tmp_path, scheduler="tcp://127.0.0.1:9", progress=False).run(SPECS[:1])
