@@ -1,4 +1,4 @@
-"""Per-phase wall time and peak memory of CTM-RPIM and scikit-fem Q1 on the cantilever, at growing n.
+"""Per-phase wall time and peak memory of CTM-RPIM and scikit-fem (Q1, P2) on the cantilever, at growing n.
 
     python benchmarks/bench_linear.py [--grids 17x5,33x9,65x17,129x33,257x65] [--repeat 3] [--csv FILE]
 
@@ -13,6 +13,7 @@ import argparse
 import time
 import tracemalloc
 
+import numpy as np
 import pandas as pd
 
 from ctmrpim import benchmarks
@@ -25,7 +26,7 @@ DEFAULT_GRIDS = "17x5,33x9,65x17,129x33,257x65"
 
 def run(grid: tuple[int, int], method: str, repeat: int) -> dict:
     case = benchmarks.load("cantilever", [f"nodes.grid=[{grid[0]}, {grid[1]}]"])
-    solve = (lambda: solve_ctmrpim(case)) if method == "ctm-rpim" else (lambda: solve_fem(case, "q1"))
+    solve = (lambda: solve_ctmrpim(case)) if method == "ctm-rpim" else (lambda: solve_fem(case, method[4:]))
     best = None
     for _ in range(repeat):
         t0 = time.perf_counter()
@@ -53,7 +54,7 @@ def main() -> None:
     solve_ctmrpim(benchmarks.load("cantilever", ["nodes.grid=[9, 3]"]))  # warm up imports and caches
     rows = []
     for g in grids:
-        for method in ("ctm-rpim", "fem-q1"):
+        for method in ("ctm-rpim", "fem-q1", "fem-p2"):
             rows.append(run(g, method, a.repeat if g[0] * g[1] < 20000 else 1))
             r = rows[-1]
             phases = "  ".join(f"{k[2:]} {v:.3f}" for k, v in r.items() if k.startswith("t_") and k != "t_total")
@@ -70,12 +71,24 @@ def main() -> None:
         cols = [c for c in d.columns if c.startswith("t_") and d[c].notna().all() and (d[c] > 0).all()]
         fits = {c[2:]: fitted_rate(d.n, d[c]) for c in cols}
         print(f"  {method:9s} " + "  ".join(f"{k} {v:.2f}" for k, v in fits.items()))
-    print("\nCTM-RPIM / FEM Q1 at equal n (total time; tip error):")
+    print("\nCTM-RPIM / FEM at equal n (total time; tip error):")
     piv = df.pivot(index="grid", columns="method", values=["t_total", "tip_error"])
     for g in df.grid.unique():
-        t = piv.loc[g, "t_total"]
-        e = piv.loc[g, "tip_error"]
-        print(f"  {g:>7}: time x{t['ctm-rpim'] / t['fem-q1']:.1f}, error x{e['ctm-rpim'] / e['fem-q1']:.2f}")
+        t, e = piv.loc[g, "t_total"], piv.loc[g, "tip_error"]
+        print(f"  {g:>7}: " + "; ".join(f"/ {m}: time x{t['ctm-rpim'] / t[m]:.1f}, error x{e['ctm-rpim'] / e[m]:.3g}"
+                                       for m in ("fem-q1", "fem-p2")))
+    print("\nCTM-RPIM / FEM at equal accuracy (FEM time interpolated to CTM-RPIM's tip error):")
+    ours = df[df.method == "ctm-rpim"]
+    for m in ("fem-q1", "fem-p2"):
+        fem = df[df.method == m].sort_values("tip_error")
+        for _, r in ours.iterrows():
+            le, lt = np.log(fem.tip_error.to_numpy()), np.log(fem.t_total.to_numpy())
+            x = np.log(r.tip_error)
+            if le.min() <= x <= le.max():
+                t_fem = float(np.exp(np.interp(x, le, lt)))
+                print(f"  {m} at {100 * r.tip_error:.4f} % ({r.grid} CTM-RPIM): time x{r.t_total / t_fem:.1f}")
+            else:
+                print(f"  {m} at {100 * r.tip_error:.4f} % ({r.grid} CTM-RPIM): outside the FEM grids of this run")
 
 
 if __name__ == "__main__":
