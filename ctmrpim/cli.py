@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import os
 import shutil
 import sys
 import warnings
@@ -141,7 +142,8 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 def _sweep_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="reports", help="folder for tables and figures (default reports/)")
-    p.add_argument("--workers", type=int, default=1, help="local worker processes for the sweeps (default 1)")
+    p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                   help="local worker processes for the sweeps (default: one per core; 1 runs in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run the sweeps on this Dask scheduler instead")
     p.add_argument("--retry-failed", action="store_true", help="recompute cases that failed before")
 

@@ -39,9 +39,11 @@ phi = pi/2 at the tip and sin phi1 = 1/(sqrt(2) k) at the root.  Then sin theta0
 
 (x(1) also follows from the root moment: theta'(0) = lambda x(1) and theta'(0)^2 = 2 lambda sin theta0.)
 The differences K - F(phi1) and E - E(phi1) cancel badly for small loads (phi1 -> pi/2), so they are
-evaluated through the complementary amplitude psi, tan(phi1) tan(psi) = 1/k' (Byrd & Friedman 1971,
-formulas 116.01 and 116.02; DLMF 19.11 with one angle pi/2):
-K - F(phi1, k) = F(psi, k) and E - E(phi1, k) = E(psi, k) - k^2 sin(phi1) sin(psi).
+evaluated through the complementary amplitude psi, cot(phi1) cot(psi) = k' = sqrt(1 - k^2) (Legendre's
+addition theorem with sum amplitude pi/2, DLMF 19.11.1-19.11.2; also in Byrd & Friedman 1971):
+K - F(phi1, k) = F(psi, k) and E - E(phi1, k) = E(psi, k) - k^2 sin(phi1) sin(psi)
+(checked against the direct differences in tests/test_elastica.py).  With tan(phi1) = 1/sqrt(sin theta0),
+tan(psi) = sqrt(sin theta0)/k', so psi ~ sqrt(2 theta0) -> 0 for small loads and nothing cancels.
 
 Small-load series (derived by expanding theta = lambda theta1 + lambda^3 theta3 + ..., theta1 = s - s^2/2):
 theta_tip = lambda/2 - 11 lambda^3/240,  w/L = lambda/3 - 4 lambda^3/105,  u/L = lambda^2/15  (+ h.o.t.).
@@ -112,6 +114,11 @@ def tip_load_elliptic(lam: float) -> ElasticaTip:
     is monotone in theta0 and unbounded at pi/2, so any lambda > 0 has one root); then
     x(1) = sqrt(2 sin theta0/lambda), w/L = 1 - 2 (E(k) - E(phi1, k))/sqrt(lambda).
     Reference for the paper's Section 3.2 (Figs. 13-17), lambda = 0.12 .. 3.6.
+
+    Range and accuracy: any 0 <= lambda <~ 800 (beyond that the tip angle is within 1e-12 of pi/2
+    and a ValueError is raised).  All three outputs are accurate to ~1e-13 absolute; for very small
+    loads the *relative* accuracy of u/L (~ lambda^2/15, obtained as 1 - x(1)) falls like
+    1e-16/lambda^2 and that of w/L like 1e-16/lambda (about 1e-11 and 1e-14 at lambda = 0.01).
     """
     lam = float(lam)
     if not lam > 0.0:

@@ -140,6 +140,13 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     w(_md(tta.assign(**{c: tta[c].map(lambda v: "" if np.isnan(v) else f"{v:.3f} s") for c in tta.columns
                          if c != "method"})))
     t = tta.set_index("method")
+    for col in [c for c in t.columns if c.startswith("time_to_")]:
+        reached = t[col].dropna().sort_values()
+        if len(reached) >= 2:
+            w(f"\n\nFirst to {col[8:]}: {reached.index[0]}, {reached.iloc[1] / reached.iloc[0]:.1f} times sooner "
+              f"than {reached.index[1]}.")
+        elif len(reached) == 1:
+            w(f"\n\nOnly {reached.index[0]} reaches {col[8:]} in this run.")
     for target in ("time_to_0.1%", "time_to_1%"):
         if not np.isnan(t.loc["ctm-rpim", target]):
             parts = [f"CTM-RPIM / {m}: x{t.loc['ctm-rpim', target] / t.loc[m, target]:.1f}"
