@@ -39,17 +39,14 @@ class ShapeFunctions:
 
 
 def _powr(r2: np.ndarray, p: float) -> np.ndarray:
-    """r^p from r^2; odd integer p takes the fast path r2^((p-1)/2) * r (no pow)."""
-    if float(p).is_integer() and p >= 1 and int(p) % 2 == 1:
-        out = np.sqrt(r2)
-        for _ in range((int(p) - 1) // 2):
-            out *= r2
-        return out
-    return np.power(r2, 0.5 * p)
+    """r^p from r^2 (a new array)."""
+    out = np.array(r2, dtype=float)
+    _powr_inplace(out, p, work=np.empty_like(out))
+    return out
 
 
 def _powr_inplace(r2: np.ndarray, p: float, work: np.ndarray) -> None:
-    """r2 <- r^p, using ``work`` (same shape) as scratch."""
+    """r2 <- r^p, ``work`` (same shape) as scratch; an odd integer p takes r2^((p-1)/2) * r (no pow)."""
     if float(p).is_integer() and p >= 1 and int(p) % 2 == 1:
         np.sqrt(r2, out=work)
         for _ in range((int(p) - 1) // 2):
