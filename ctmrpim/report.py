@@ -27,7 +27,7 @@ RATE_GRIDS = ["17 x 5", "33 x 9", "65 x 17"]
 
 def _row(key: str, value: float, variant: str = "") -> dict:
     e = tolerances.entry(key)
-    shown = f"{value:.3f}" if tolerances.is_dimensionless(key) else f"{100 * value:.4g} %"
+    shown = f"{value:.4g}" if tolerances.is_dimensionless(key) else f"{100 * value:.4g} %"
     return {"check": key + (f" ({variant})" if variant else ""), "quantity": e["quantity"],
             "reference": e["reference"], "ours": shown, "limit": tolerances.describe_limit(key),
             "pass": "pass" if tolerances.passes(key, value) else "FAIL", "limit source": e["source"]}

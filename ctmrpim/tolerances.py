@@ -23,8 +23,8 @@ def passes(key: str, value: float) -> bool:
 
 
 def is_dimensionless(key: str) -> bool:
-    """Rates and ratios are shown as plain numbers, relative errors in percent."""
-    return entry(key).get("unit") in ("rate", "ratio")
+    """Rates, ratios and absolute differences are shown as plain numbers, relative errors in percent."""
+    return entry(key).get("unit") in ("rate", "ratio", "absolute")
 
 
 def describe_limit(key: str) -> str:
