@@ -62,6 +62,7 @@ def summary_dict(result: Result, source: str) -> dict[str, Any]:
         "timings": result.timings,
         "probes": result.probes,
         "errors": result.errors,
+        **({"history": result.history} if result.history else {}),
     }
 
 

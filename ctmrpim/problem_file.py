@@ -11,7 +11,7 @@ import copy
 import difflib
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +20,7 @@ import numpy as np
 from .errors import ProblemError
 from .expressions import Field, constant
 from .geometry import CIRCLE_SAGITTA, Geometry, Shape
+from .hyperelastic import NeoHookean
 from .material import LinearElastic
 from .method import Method
 from .nodes import NodeSpec
@@ -37,6 +38,7 @@ SECTIONS: dict[str, set[str] | None] = {
     "pressure": {"where", "p"},
     "probe": {"name", "at"},
     "exact": {"ux", "uy", "sxx", "syy", "sxy"},
+    "loading": {"steps", "tolerance", "max_iterations", "max_cutbacks"},
 }
 LIST_SECTIONS = {"constraint", "traction", "pressure", "probe"}
 REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E", "nu"],
@@ -45,8 +47,28 @@ REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E",
 #: Names people reach for instead of the file's keys, to suggest where difflib finds no close spelling.
 SYNONYMS = {"youngs": "E", "young": "E", "youngs_modulus": "E", "young_modulus": "E", "modulus": "E",
             "poisson": "nu", "poissons_ratio": "nu", "poisson_ratio": "nu", "rho": "density"}
-ANALYSES = ("linear",)
-MATERIAL_MODELS = ("linear-elastic",)
+ANALYSES = ("linear", "quasi-static")
+MATERIAL_MODELS = ("linear-elastic", "neo-hookean")
+#: the material model each analysis solves
+ANALYSIS_MODEL = {"linear": "linear-elastic", "quasi-static": "neo-hookean"}
+
+
+@dataclass(frozen=True)
+class Loading:
+    """Load stepping of a quasi-static analysis (Section 2.1.3)."""
+
+    steps: int = 10                # equal load increments (halved on non-convergence)
+    tolerance: float = 1e-8        # Newton: relative residual and displacement-increment norms
+    max_iterations: int = 25       # Newton iterations per increment before a cut-back
+    max_cutbacks: int = 8          # increment halvings before the solve gives up
+
+    def __post_init__(self) -> None:
+        for key, ok in (("steps", isinstance(self.steps, int) and self.steps >= 1),
+                        ("tolerance", 0 < self.tolerance < 1),
+                        ("max_iterations", isinstance(self.max_iterations, int) and self.max_iterations >= 1),
+                        ("max_cutbacks", isinstance(self.max_cutbacks, int) and self.max_cutbacks >= 0)):
+            if not ok or isinstance(getattr(self, key), bool):
+                raise ProblemError(f"{getattr(self, key)!r} is out of range", key=f"loading.{key}")
 
 
 @dataclass
@@ -60,6 +82,7 @@ class Case:
     base_dir: Path
     resolved: dict[str, Any] = field(default_factory=dict)
     defaults: list[str] = field(default_factory=list)
+    loading: Loading = field(default_factory=Loading)
 
 
 def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
@@ -150,8 +173,15 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     if mat.get("model") not in MATERIAL_MODELS:
         raise ProblemError(f"model {mat.get('model')!r} is not supported (supported: {', '.join(MATERIAL_MODELS)})",
                            key="material.model")
+    if mat["model"] != ANALYSIS_MODEL[analysis]:
+        raise ProblemError(f"analysis {analysis!r} needs model = {ANALYSIS_MODEL[analysis]!r}, not {mat['model']!r}",
+                           key="material.model")
     material = LinearElastic(E=num(mat["E"], "material.E"), nu=num(mat["nu"], "material.nu"),
                              density=num(get("material", "density", 0.0), "material.density"))
+    if mat["model"] == "neo-hookean":
+        material = NeoHookean(material.E, material.nu, material.density)
+    loading_raw = raw.get("loading", {})
+    loading = Loading(**{k: (num(v, f"loading.{k}") if k == "tolerance" else v) for k, v in loading_raw.items()})
 
     constraints = []
     for i, c in enumerate(raw.get("constraint", [])):
@@ -236,8 +266,10 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         "probe": [{"name": p.name, "at": [p.x, p.y]} for p in probes],
         "exact": {k: str(v) for k, v in raw.get("exact", {}).items()},
     }
+    if analysis == "quasi-static":
+        resolved["loading"] = asdict(loading)
     return Case(problem=problem, nodes=nodes, method=method, source=source, base_dir=base_dir,
-                resolved=resolved, defaults=defaults)
+                resolved=resolved, defaults=defaults, loading=loading)
 
 
 def _grid(value: Any, num) -> tuple[int, int]:

@@ -24,6 +24,7 @@ class Result:
     timings: dict[str, float] = field(default_factory=dict)
     parameters: dict[str, Any] = field(default_factory=dict)   # fully resolved input and derived values
     defaults: list[str] = field(default_factory=list)          # defaults that were applied
+    history: list[dict[str, Any]] = field(default_factory=list)  # one entry per load increment
 
 
 def probe_record(x: float, y: float, u: np.ndarray, s: np.ndarray) -> dict[str, float]:

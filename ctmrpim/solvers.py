@@ -11,7 +11,13 @@ ELEMENTS = ("q1", "p1", "p2")
 def solve(case: Case, solver: str = "ctm-rpim", element: str = "q1") -> Result:
     """Solve ``case`` with CTM-RPIM, or with scikit-fem ``element`` when ``solver == "fem"``."""
     if solver == "fem":
+        if case.problem.analysis != "linear":
+            from .errors import ProblemError
+            raise ProblemError("the scikit-fem reference solves linear analyses only (so far)", key="--solver")
         from reference_fem import solve_fem
         return solve_fem(case, element)
+    if case.problem.analysis == "quasi-static":
+        from .total_lagrangian import solve_total_lagrangian
+        return solve_total_lagrangian(case)
     from .linear_static import solve_ctmrpim
     return solve_ctmrpim(case)

@@ -1,0 +1,158 @@
+"""Quasi-static total-Lagrangian CTM-RPIM with a hyperelastic material (Section 2.1.3, TL form).
+
+The cross-check of the adaptive updated-Lagrangian path (DESIGN.md): boundary, CTM points, RPIM
+supports and shape functions all live on the reference configuration and are built once. Loads are
+applied in increments; each increment is solved by Newton-Raphson on F_ext - F_int with a residual
+and a displacement criterion. An increment that does not converge is cut in half and retried (and
+the history says so, never silently), and grows back after easy increments; loads are dead (nominal
+tractions on the reference boundary).
+
+    F_int[I, i] = sum_p w_p P_iJ(p) dN_I/dX_J(p)
+    K[(I, i), (K, k)] = sum_p w_p dN_I/dX_J A_iJkL dN_K/dX_L        (G^T diag(w A) G, sparse)
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from . import assembly
+from .boundary_conditions import constrained_dofs, loaded_boundary
+from .errors import ProblemError
+from .hyperelastic import NeoHookean
+from .linear_solver import solve_constrained
+from .linear_static import Timer, discretise
+from .problem_file import Case
+from .result import Result, probe_record
+from .rpim import shape_functions
+
+
+def gradient_operator(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix) -> sp.csr_matrix:
+    """G (4m x 2n): row 4p + c, c = xX, xY, yX, yY, gives du_i/dX_J at point p from interleaved dofs.
+    ``dNdx`` and ``dNdy`` share one sparsity pattern (they come from one RPIM solve)."""
+    m, n = dNdx.shape
+    counts = np.repeat(np.diff(dNdx.indptr), 4)                  # each point's support, once per row c
+    indptr = np.concatenate([[0], np.cumsum(counts)])
+    gather = np.repeat(np.repeat(dNdx.indptr[:-1], 4) - indptr[:-1], counts) + np.arange(indptr[-1])
+    c = np.repeat(np.tile(np.arange(4), m), counts)
+    data = np.where(c % 2 == 0, dNdx.data[gather], dNdy.data[gather])   # J = X for c = 0, 2
+    indices = 2 * dNdx.indices[gather] + (c >= 2)                      # i = y for c = 2, 3
+    return sp.csr_matrix((data, indices, indptr), shape=(4 * m, 2 * n))
+
+
+def _internal_force(G: sp.csr_matrix, P: np.ndarray, w: np.ndarray) -> np.ndarray:
+    return G.T @ (P.reshape(-1, 4) * w[:, None]).ravel()
+
+
+def _tangent(G: sp.csr_matrix, A: np.ndarray, w: np.ndarray) -> sp.csr_matrix:
+    m = len(w)
+    blocks = A.reshape(m, 4, 4) * w[:, None, None]
+    WA = sp.bsr_matrix((blocks, np.arange(m), np.arange(m + 1)), shape=(4 * m, 4 * m))
+    return (G.T @ (WA @ G)).tocsr()
+
+
+def _cauchy(material: NeoHookean, G: sp.csr_matrix, U: np.ndarray) -> np.ndarray:
+    """(m, 3) Cauchy stress sxx, syy, sxy = P F^T / J at the rows of G (stored on the reference points)."""
+    F = np.eye(2)[None] + (G @ U).reshape(-1, 2, 2)
+    P, _ = material.stress_tangent(F)
+    sig = P @ F.transpose(0, 2, 1) / np.linalg.det(F)[:, None, None]
+    return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1]]
+
+
+def solve_total_lagrangian(case: Case) -> Result:
+    """Load-stepped Newton solve of a hyperelastic Case (``case.loading``); ``Result.history`` has one
+    entry per increment (and one per cut-back)."""
+    problem, method = case.problem, case.method
+    material = problem.material
+    if not isinstance(material, NeoHookean):
+        raise ProblemError("the total-Lagrangian solver needs model = \"neo-hookean\"", key="material.model")
+    steps, tolerance = case.loading.steps, case.loading.tolerance
+    max_iterations, max_cutbacks = case.loading.max_iterations, case.loading.max_cutbacks
+    if problem.plane != "strain":
+        raise ProblemError("the neo-Hookean model is implemented in plane strain; set problem.plane = \"strain\"",
+                           key="problem.plane")
+    timer = Timer()
+    disc = discretise(case, timer)
+    nodes, d_c, quad = disc.nodes, disc.d_c, disc.quadrature
+    tol = method.match_tolerance * d_c
+    boundary_nodes = np.unique(np.concatenate(disc.boundary.loops))
+    fixed, fixed_values = constrained_dofs(problem, nodes, boundary_nodes, tol)
+    traction_q, tx, ty = loaded_boundary(problem, nodes, disc.boundary.edges, tol)
+    rpim = dict(support_radius=method.support_radius * d_c, eta=method.eta,
+                polynomial_terms=method.polynomial_terms, scale=d_c, tree=cKDTree(nodes))
+    sf = shape_functions(nodes, quad.points, **rpim)
+    sf_t = shape_functions(nodes, traction_q.points, derivatives=False, **rpim)
+    probe_xy = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
+    sf_p = shape_functions(nodes, probe_xy, **rpim) if len(probe_xy) else None
+    timer.lap("shape_functions")
+    G = gradient_operator(sf.dNdx, sf.dNdy)
+    w = quad.weights * problem.thickness
+    F_full = assembly.load_vector(sf_t.N, traction_q.weights * problem.thickness, tx, ty)
+    timer.lap("assembly")
+
+    n = len(nodes)
+    U = np.zeros(2 * n)
+    history: list[dict] = []
+    factor, dfactor, cutbacks = 0.0, 1.0 / steps, 0
+    newton_iterations = 0
+    while factor < 1.0 - 1e-12:
+        target = min(1.0, factor + dfactor)
+        trial, converged, it = U.copy(), False, 0
+        f_ext = target * F_full
+        trial[fixed] = target * fixed_values
+        ref = max(np.linalg.norm(f_ext), 1e-30)
+        for it in range(1, max_iterations + 1):
+            H = (G @ trial).reshape(-1, 2, 2)
+            try:
+                P, A = material.stress_tangent(np.eye(2)[None] + H)
+            except ProblemError:
+                break
+            residual = f_ext - _internal_force(G, P, w)
+            residual[fixed] = 0.0
+            K = _tangent(G, A, w)
+            du = solve_constrained(K, residual, fixed, np.zeros(len(fixed)), method.solver)
+            trial += du
+            newton_iterations += 1
+            if np.linalg.norm(residual) <= tolerance * ref and np.linalg.norm(du) <= tolerance * max(np.linalg.norm(trial), 1e-30):
+                converged = True
+                break
+        if not converged:
+            if cutbacks >= max_cutbacks:
+                raise ProblemError(f"Newton did not converge at load factor {target:.4g} after {max_cutbacks} "
+                                   "cut-backs; use more load steps", key="loading")
+            cutbacks += 1
+            dfactor *= 0.5
+            history.append({"load_factor": target, "converged": False, "iterations": it,
+                            "note": f"increment cut back to {dfactor:.4g}"})
+            continue
+        U, factor = trial, target
+        if it <= max_iterations // 2:   # an easy increment: let a cut-back step grow back towards 1/steps
+            dfactor = min(2.0 * dfactor, 1.0 / steps)
+        u = U.reshape(-1, 2)
+        rec = {"load_factor": factor, "converged": True, "iterations": it}
+        if sf_p is not None:
+            up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
+            for i, p in enumerate(problem.probes):
+                rec[p.name] = {"x": p.x, "y": p.y, "ux": float(up[i, 0]), "uy": float(up[i, 1])}
+        history.append(rec)
+    timer.lap("solve")
+
+    u = U.reshape(-1, 2)
+    sf_n = shape_functions(nodes, nodes, **rpim)
+    stress = _cauchy(material, gradient_operator(sf_n.dNdx, sf_n.dNdy), U)
+    probes = {}
+    if sf_p is not None:
+        up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
+        sig = _cauchy(material, gradient_operator(sf_p.dNdx, sf_p.dNdy), U)
+        probes = {p.name: probe_record(p.x, p.y, up[i], sig[i]) for i, p in enumerate(problem.probes)}
+    timer.lap("postprocess")
+    sizes = sf.support_sizes
+    return Result(
+        method="ctm-rpim-tl", points=nodes, u=u, stress=stress,
+        cells=[("line", disc.boundary.edges)], probes=probes, errors={},
+        counts={"nodes": n, "integration_points": len(w), "load_increments": sum(h["converged"] for h in history),
+                "cutbacks": cutbacks, "newton_iterations": newton_iterations,
+                "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},
+        timings=timer.total(), history=history,
+        parameters={**case.resolved, "derived": {"d_c": d_c, "mu": material.mu, "lambda": material.lam}},
+        defaults=case.defaults)

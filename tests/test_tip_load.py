@@ -1,0 +1,62 @@
+"""Tip-loaded cantilever with large deflection (paper Figs. 13-15), total-Lagrangian CTM-RPIM against
+the exact elastica; Newton history and cut-backs."""
+from __future__ import annotations
+
+import pytest
+from verify import check
+
+from ctmrpim import benchmarks, elastica
+from ctmrpim.errors import ProblemError
+from ctmrpim.solvers import solve
+
+L = 10.0
+
+
+@pytest.fixture(scope="module")
+def solved():
+    return solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=4"]))
+
+
+def test_tip_deflection_against_the_elastica(solved) -> None:
+    exact = elastica.tip_load_elliptic(1.2)
+    w = -solved.probes["tip"]["uy"] / L
+    check("tip-load-tl-elastica", abs(w / exact.w_over_L - 1.0))
+    u = -solved.probes["tip"]["ux"] / L           # the tip moves back towards the root
+    check("tip-load-tl-elastica-shortening", abs(u / exact.u_over_L - 1.0))
+
+
+def test_history_has_every_increment(solved) -> None:
+    h = solved.history
+    assert [r["load_factor"] for r in h] == pytest.approx([0.25, 0.5, 0.75, 1.0])
+    assert all(r["converged"] and r["iterations"] <= 8 for r in h)
+    deflections = [-r["tip"]["uy"] for r in h]
+    assert deflections == sorted(deflections)      # monotone load-displacement curve
+    assert solved.counts["cutbacks"] == 0
+
+
+def test_cut_back_is_reported_not_silent() -> None:
+    r = solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=1", "loading.max_iterations=6"]))
+    assert r.counts["cutbacks"] >= 1
+    assert any(not h["converged"] and "cut back" in h["note"] for h in r.history)
+    assert r.history[-1]["load_factor"] == pytest.approx(1.0)
+
+
+def test_newton_failure_is_a_clear_error() -> None:
+    with pytest.raises(ProblemError, match="did not converge"):
+        solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=1", "loading.max_iterations=1",
+                                           "loading.max_cutbacks=1"]))
+
+
+@pytest.mark.parametrize("overrides, message", [
+    (['material.model="linear-elastic"'], "needs model = 'neo-hookean'"),
+    (['problem.analysis="linear"'], "needs model = 'linear-elastic'"),
+    (["loading.steps=0"], "loading.steps"),
+])
+def test_inconsistent_analysis_and_material_are_errors(overrides, message: str) -> None:
+    with pytest.raises(ProblemError, match=message):
+        benchmarks.load("tip-load", overrides)
+
+
+def test_fem_reference_refuses_nonlinear_analyses() -> None:
+    with pytest.raises(ProblemError, match="linear analyses only"):
+        solve(benchmarks.load("tip-load"), "fem", "q1")
