@@ -33,7 +33,7 @@ def _row(key: str, value: float, variant: str = "") -> dict:
             "pass": "pass" if tolerances.passes(key, value) else "FAIL", "limit source": e["source"]}
 
 
-def verification_checks(nd: pd.DataFrame, plate: pd.DataFrame) -> pd.DataFrame:
+def verification_checks(nd: pd.DataFrame, plate: pd.DataFrame, tip: pd.DataFrame) -> pd.DataFrame:
     """The accuracy checks of the linear benchmarks (analytical references)."""
     nd = nd[nd.status == "ok"]
 
@@ -58,6 +58,9 @@ def verification_checks(nd: pd.DataFrame, plate: pd.DataFrame) -> pd.DataFrame:
         rows += [_row("plate-hole-ctmrpim-energy", at.loc[(plane, "ctm-rpim"), "energy_error"], f"plane {plane}"),
                  _row("plate-hole-ctmrpim-l2", at.loc[(plane, "ctm-rpim"), "l2_error"], f"plane {plane}"),
                  _row("plate-hole-fem-p2-energy", at.loc[(plane, "fem-p2"), "energy_error"], f"plane {plane}")]
+    tip = tip[tip.status == "ok"]
+    rows += [_row("tip-load-tl-elastica", float(tip.w_rel_diff.abs().max()), "worst over the loads run"),
+             _row("tip-load-tl-elastica-shortening", float(tip.u_rel_diff.abs().max()), "worst over the loads run")]
     return pd.DataFrame(rows)
 
 
@@ -92,7 +95,7 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     out_dir = Path(out_dir)
     tables = {name: studies.study(name).run(quick, out_dir, sweep, progress) for name in studies.NAMES}
     nd, plate = tables["node_density"], tables["plate_hole_convergence"]
-    checks = verification_checks(nd, plate)
+    checks = verification_checks(nd, plate, tables["tip_load"])
     claim_rows = claims_table(tables)
     tta = targets_table(tables["time_to_accuracy"])
     errs = ("tip_error", "l2_error", "energy_error")
@@ -174,6 +177,18 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
       "and 5000 at 0.0625 against 3000 (full mode), because single-point line integration under-resolves the "
       "cut cells along the arc (two Gauss points give 3185 at 0.125). The energy-norm error still falls with "
       "refinement; P2 finite elements are more accurate at equal nodes here too.\n")
+    w("\n## Large deflection: tip-loaded cantilever (cf. Figs. 13-14)\n\n")
+    w(f"{studies.study('tip_load').__doc__.strip()}\n\n")
+    tl = tables["tip_load"].drop(columns=["status", "d_c", "tip_error", "l2_error", "energy_error", "method"],
+                                 errors="ignore")
+    w(_md(tl.assign(w_rel_diff=tl.w_rel_diff.map(lambda v: f"{100 * v:+.2f} %"),
+                    u_rel_diff=tl.u_rel_diff.map(lambda v: f"{100 * v:+.2f} %"),
+                    time_s=tl.time_s.map(lambda v: f"{v:.2f}"))))
+    w("\n\n![tip load](tip_load.png)\n\nThe continuum beam (W/L = 0.1) is slightly more flexible than the "
+      "inextensible, shear-rigid elastica: +1.1-1.2 % in w/L at every load, of which shear accounts for about "
+      "0.6 % at small loads. This is the total-Lagrangian cross-check; the adaptive updated-Lagrangian path "
+      "(re-tracked boundary every increment), the corner-load variant, the end-moment ring and the FEM "
+      "reference of this problem are still to come.\n")
     path = out_dir / "REPORT.md"
     atomic_write_text(path, buf.getvalue())
     progress("\n" + pd.concat([checks[["check", "ours", "limit", "pass"]],

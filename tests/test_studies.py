@@ -37,6 +37,12 @@ def test_outputs_written(tables, tmp_path_factory) -> None:
         assert len(pd.read_csv(reports / f"{name}.csv")) == len(tables[name])
 
 
+def test_tip_load_study_against_the_elastica(tables) -> None:
+    tip = tables["tip_load"]
+    check("tip-load-tl-elastica", tip.w_rel_diff.abs().max())
+    check("tip-load-tl-elastica-shortening", tip.u_rel_diff.abs().max())
+
+
 def test_time_to_accuracy_targets(tables) -> None:
     from studies.time_to_accuracy import targets_table
 
