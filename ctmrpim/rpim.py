@@ -94,8 +94,12 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
                       derivatives)
 
     # each small LAPACK solve runs on one thread; BLAS threads on top of ours would only contend
-    with threadpool_limits(limits=1, user_api="blas"), ThreadPoolExecutor(max_workers=THREADS) as pool:
-        parts = list(pool.map(work, bounds))
+    with threadpool_limits(limits=1, user_api="blas"):
+        if len(bounds) > 1 and THREADS > 1:
+            with ThreadPoolExecutor(max_workers=THREADS) as pool:
+                parts = list(pool.map(work, bounds))
+        else:  # one chunk (tractions, probes): no pool to start
+            parts = [work(b) for b in bounds]
     shape = (len(points), len(nodes))
     if parts:
         indices = np.concatenate([p[0] for p in parts])
