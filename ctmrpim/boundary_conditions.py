@@ -52,7 +52,7 @@ def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol:
                     ) -> tuple[BoundaryQuadrature, np.ndarray, np.ndarray]:
     """Gauss points on every loaded boundary segment and the traction (tx, ty) at each point."""
     x, y = nodes[:, 0], nodes[:, 1]
-    pts, wts, nrm, tx_all, ty_all = [], [], [], [], []
+    pts, wts, nrm, tx_all, ty_all, ends, follow = [], [], [], [], [], [], []
     loads = [("traction", i, t.where) for i, t in enumerate(problem.tractions)] + \
             [("pressure", i, p.where) for i, p in enumerate(problem.pressures)]
     for kind, i, where in loads:
@@ -62,6 +62,8 @@ def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol:
             raise ProblemError(f"where = {where.text!r} selects no boundary segment", key=f"{kind}[{i}].where")
         q = boundary_points(nodes[seg], TRACTION_GAUSS_POINTS)
         px, py = q.points[:, 0], q.points[:, 1]
+        ends.append(np.repeat(seg, TRACTION_GAUSS_POINTS, axis=0))
+        follow.append(np.full(len(px), kind == "traction" and problem.tractions[i].follower))
         if kind == "traction":
             t = problem.tractions[i]
             tx = _values(t.tx, px, py, f"traction[{i}].tx") if t.tx is not None else np.zeros(len(px))
@@ -71,9 +73,11 @@ def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol:
             tx, ty = -p * q.normals[:, 0], -p * q.normals[:, 1]
         pts.append(q.points); wts.append(q.weights); nrm.append(q.normals); tx_all.append(tx); ty_all.append(ty)
     if not pts:
-        empty = BoundaryQuadrature(np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, int))
+        empty = BoundaryQuadrature(np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, int),
+                                   np.zeros((0, 2), int), np.zeros(0, bool))
         return empty, np.zeros(0), np.zeros(0)
-    q = BoundaryQuadrature(np.concatenate(pts), np.concatenate(wts), np.concatenate(nrm), np.zeros(0, int))
+    q = BoundaryQuadrature(np.concatenate(pts), np.concatenate(wts), np.concatenate(nrm), np.zeros(0, int),
+                           np.concatenate(ends), np.concatenate(follow))
     return q, np.concatenate(tx_all), np.concatenate(ty_all)
 
 

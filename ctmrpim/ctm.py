@@ -124,6 +124,8 @@ class BoundaryQuadrature:
     weights: np.ndarray    # (m,) length weights
     normals: np.ndarray    # (m, 2) outward unit normals
     segment: np.ndarray    # (m,) index of the boundary segment each point lies on
+    ends: np.ndarray | None = None      # (m, 2) node indices of that segment, where known
+    follower: np.ndarray | None = None  # (m,) the load at the point turns with its segment
 
 
 def boundary_points(segments: np.ndarray, gauss_points: int = 2) -> BoundaryQuadrature:

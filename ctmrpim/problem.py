@@ -27,11 +27,14 @@ class Constraint:
 
 @dataclass
 class Traction:
-    """Surface traction (force per unit area, global x/y components) on selected boundary segments."""
+    """Surface traction (force per unit area, global x/y components) on selected boundary segments.
+    A follower traction turns with the boundary segment it acts on (large-deformation analyses); a
+    dead one keeps its direction and nominal size."""
 
     where: Field
     tx: Field | None = None
     ty: Field | None = None
+    follower: bool = False
 
 
 @dataclass

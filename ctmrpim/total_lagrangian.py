@@ -3,7 +3,7 @@
 The cross-check of the adaptive updated-Lagrangian path (DESIGN.md): boundary, CTM points, RPIM
 supports and shape functions all live on the reference configuration and are built once. Loads are
 applied in increments; each increment is solved by Newton-Raphson on F_ext - F_int with a residual
-and a displacement criterion. An increment that does not converge is cut in half and retried (and
+and a displacement criterion and a backtracking line search on the residual norm. An increment that does not converge is cut in half and retried (and
 the history says so, never silently), and grows back after easy increments; loads are dead (nominal
 tractions on the reference boundary).
 
@@ -38,6 +38,26 @@ def gradient_operator(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix) -> sp.csr_matrix
     data = np.where(c % 2 == 0, dNdx.data[gather], dNdy.data[gather])   # J = X for c = 0, 2
     indices = 2 * dNdx.indices[gather] + (c >= 2)                      # i = y for c = 2, 3
     return sp.csr_matrix((data, indices, indptr), shape=(4 * m, 2 * n))
+
+
+def _value_operator(N: sp.csr_matrix) -> sp.csr_matrix:
+    """(2m x 2n): rows (p, i) give u_i at point p from interleaved dofs."""
+    m, n = N.shape
+    counts = np.repeat(np.diff(N.indptr), 2)
+    indptr = np.concatenate([[0], np.cumsum(counts)])
+    gather = np.repeat(np.repeat(N.indptr[:-1], 2) - indptr[:-1], counts) + np.arange(indptr[-1])
+    i = np.repeat(np.tile(np.arange(2), m), counts)
+    return sp.csr_matrix((N.data[gather], 2 * N.indices[gather] + i, indptr), shape=(2 * m, 2 * n))
+
+
+def _difference_operator(ends: np.ndarray, n_nodes: int) -> sp.csr_matrix:
+    """(2m x 2n): rows (p, j) give u_j(end 1) - u_j(end 0) of the segment point p lies on."""
+    m = len(ends)
+    rows = np.repeat(np.arange(2 * m), 2)
+    j = np.tile(np.repeat(np.arange(2), 2), m)
+    cols = 2 * np.stack([ends[:, 1], ends[:, 0]], axis=1).repeat(2, axis=0).ravel() + j
+    vals = np.tile([1.0, -1.0], 2 * m)
+    return sp.csr_matrix((vals, (rows, cols)), shape=(2 * m, 2 * n_nodes))
 
 
 def _internal_force(G: sp.csr_matrix, P: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -87,7 +107,38 @@ def solve_total_lagrangian(case: Case) -> Result:
     timer.lap("shape_functions")
     G = gradient_operator(sf.dNdx, sf.dNdy)
     w = quad.weights * problem.thickness
-    F_full = assembly.load_vector(sf_t.N, traction_q.weights * problem.thickness, tx, ty)
+    wt = traction_q.weights * problem.thickness
+    follower = traction_q.follower
+    d0 = nodes[traction_q.ends[:, 1]] - nodes[traction_q.ends[:, 0]]
+
+    len0 = np.linalg.norm(d0, axis=1)
+    e0, p0 = d0 / len0[:, None], np.c_[-d0[:, 1], d0[:, 0]] / len0[:, None]
+    Bn = _value_operator(sf_t.N)
+    Ed = _difference_operator(traction_q.ends, n_nodes=len(nodes))
+
+    def external(U: np.ndarray, factor: float) -> tuple[np.ndarray, sp.csr_matrix | None]:
+        """Load vector and its stiffness -dF_ext/dU. Dead tractions keep their direction; follower
+        tractions turn with their segment: t = R(theta) t0 per unit reference length, with
+        cos theta = e0 . e and sin theta = (e0 x e) of the reference and current unit directions."""
+        if not follower.any():
+            return factor * F_dead, None
+        u = U.reshape(-1, 2)
+        d = d0 + u[traction_q.ends[:, 1]] - u[traction_q.ends[:, 0]]
+        length = np.linalg.norm(d, axis=1)
+        e = d / length[:, None]
+        c, s_ = (e0 * e).sum(1), (p0 * e).sum(1)
+        rx = np.where(follower, c * tx - s_ * ty, tx)
+        ry = np.where(follower, s_ * tx + c * ty, ty)
+        # d(c, s)/dd = (e0, p0)^T (I - e e^T) / |d|; d(R t0)/dd for each point, zero for dead loads
+        proj = (np.eye(2)[None] - e[:, :, None] * e[:, None, :]) / length[:, None, None]
+        dc, ds = np.einsum("pi,pij->pj", e0, proj), np.einsum("pi,pij->pj", p0, proj)
+        M = np.stack([tx[:, None] * dc - ty[:, None] * ds, tx[:, None] * ds + ty[:, None] * dc], axis=1)
+        M *= (follower * wt * factor)[:, None, None]
+        MB = sp.bsr_matrix((M, np.arange(len(M)), np.arange(len(M) + 1)), shape=(2 * len(M), 2 * len(M)))
+        return factor * assembly.load_vector(sf_t.N, wt, rx, ry), -(Bn.T @ (MB @ Ed)).tocsr()
+
+    F_dead = assembly.load_vector(sf_t.N, wt, tx, ty)
+
     timer.lap("assembly")
 
     n = len(nodes)
@@ -98,10 +149,10 @@ def solve_total_lagrangian(case: Case) -> Result:
     while factor < 1.0 - 1e-12:
         target = min(1.0, factor + dfactor)
         trial, converged, it = U.copy(), False, 0
-        f_ext = target * F_full
         trial[fixed] = target * fixed_values
-        ref = max(np.linalg.norm(f_ext), 1e-30)
+        ref = max(np.linalg.norm(external(trial, target)[0]), 1e-30)
         for it in range(1, max_iterations + 1):
+            f_ext, K_load = external(trial, target)
             H = (G @ trial).reshape(-1, 2, 2)
             try:
                 P, A = material.stress_tangent(np.eye(2)[None] + H)
@@ -110,7 +161,10 @@ def solve_total_lagrangian(case: Case) -> Result:
             residual = f_ext - _internal_force(G, P, w)
             residual[fixed] = 0.0
             K = _tangent(G, A, w)
-            du = solve_constrained(K, residual, fixed, np.zeros(len(fixed)), method.solver)
+            if K_load is not None:   # follower loads make the tangent non-symmetric: no Cholesky
+                K = K + K_load
+            du = solve_constrained(K, residual, fixed, np.zeros(len(fixed)),
+                                   "superlu" if K_load is not None else method.solver)
             trial += du
             newton_iterations += 1
             if np.linalg.norm(residual) <= tolerance * ref and np.linalg.norm(du) <= tolerance * max(np.linalg.norm(trial), 1e-30):

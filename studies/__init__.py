@@ -9,7 +9,7 @@ from importlib import import_module
 from types import ModuleType
 
 NAMES = ["node_density", "integration_density", "support_radius", "shape_parameter", "parameter_map",
-         "time_to_accuracy", "plate_hole_convergence", "tip_load"]
+         "time_to_accuracy", "plate_hole_convergence", "tip_load", "end_moment"]
 #: command-line spelling (dashes) -> module name
 ALIASES = {n.replace("_", "-"): n for n in NAMES}
 

@@ -43,6 +43,10 @@ def test_tip_load_study_against_the_elastica(tables) -> None:
     check("tip-load-tl-elastica-shortening", tip.u_rel_diff.abs().max())
 
 
+def test_end_moment_study(tables) -> None:
+    check("end-moment-tl-quarter", tables["end_moment"].tip_distance_over_L.iloc[0])
+
+
 def test_time_to_accuracy_targets(tables) -> None:
     from studies.time_to_accuracy import targets_table
 
