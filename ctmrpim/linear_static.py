@@ -15,7 +15,7 @@ from scipy.spatial import cKDTree
 from . import assembly
 from .alpha_shape import Boundary, alpha_shape, validate
 from .boundary_conditions import constrained_dofs, loaded_boundary
-from .ctm import Quadrature, integration_points
+from .ctm import BoundaryQuadrature, Quadrature, integration_points
 from .error_norms import relative_errors
 from .errors import ProblemError
 from .linear_solver import solve_constrained
@@ -23,7 +23,7 @@ from .method import mean_node_spacing
 from .nodes import check_nodes_inside, make_nodes
 from .problem_file import Case
 from .result import Result, probe_errors, probe_record
-from .rpim import shape_functions
+from .rpim import ShapeFunctions, shape_functions
 
 #: Error-norm quadrature: bands and sub-segments at most this many d_c, this many Gauss points each way.
 #: Checked against 0.5 d_c cells with 4 x 4 points: the energy-norm error comes out within 1 % of its
@@ -83,24 +83,49 @@ def discretise(case: Case, timer: Timer) -> Discretisation:
     return Discretisation(nodes=nodes, d_c=d_c, boundary=boundary, quadrature=quad)
 
 
-def solve_ctmrpim(case: Case) -> Result:
-    """Solve a linear-elastic Case with CTM-RPIM."""
+@dataclass
+class Configuration:
+    """Everything built on one configuration of the node cloud: boundary, integration points, the
+    constrained dofs, the loaded boundary points and the RPIM shape functions at both sets of points."""
+
+    disc: Discretisation
+    boundary_nodes: np.ndarray
+    fixed: np.ndarray
+    fixed_values: np.ndarray
+    traction: BoundaryQuadrature
+    tx: np.ndarray
+    ty: np.ndarray
+    rpim: dict
+    sf: ShapeFunctions
+    sf_traction: ShapeFunctions
+
+
+def build_configuration(case: Case, timer: Timer) -> Configuration:
     problem, method = case.problem, case.method
-    timer = Timer()
     disc = discretise(case, timer)
-    nodes, d_c, quad = disc.nodes, disc.d_c, disc.quadrature
+    nodes, d_c = disc.nodes, disc.d_c
     tol = method.match_tolerance * d_c
     boundary_nodes = np.unique(np.concatenate(disc.boundary.loops))
     fixed, fixed_values = constrained_dofs(problem, nodes, boundary_nodes, tol)
     traction_q, tx, ty = loaded_boundary(problem, nodes, disc.boundary.edges, tol)
     timer.lap("integration")
-
-    tree = cKDTree(nodes)
     rpim = dict(support_radius=method.support_radius * d_c, eta=method.eta,
-                polynomial_terms=method.polynomial_terms, scale=d_c, tree=tree)
-    sf = shape_functions(nodes, quad.points, **rpim)
+                polynomial_terms=method.polynomial_terms, scale=d_c, tree=cKDTree(nodes))
+    sf = shape_functions(nodes, disc.quadrature.points, **rpim)
     sf_t = shape_functions(nodes, traction_q.points, derivatives=False, **rpim)
     timer.lap("shape_functions")
+    return Configuration(disc, boundary_nodes, fixed, fixed_values, traction_q, tx, ty, rpim, sf, sf_t)
+
+
+def solve_ctmrpim(case: Case) -> Result:
+    """Solve a linear-elastic Case with CTM-RPIM."""
+    problem, method = case.problem, case.method
+    timer = Timer()
+    conf = build_configuration(case, timer)
+    disc, rpim, sf, sf_t = conf.disc, conf.rpim, conf.sf, conf.sf_traction
+    nodes, d_c, quad = disc.nodes, disc.d_c, disc.quadrature
+    fixed, fixed_values, traction_q, tx, ty = conf.fixed, conf.fixed_values, conf.traction, conf.tx, conf.ty
+    boundary_nodes, tol = conf.boundary_nodes, method.match_tolerance * d_c
 
     D = problem.D()
     K = assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights * problem.thickness, D)

@@ -14,14 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
 from . import assembly
-from .boundary_conditions import constrained_dofs, loaded_boundary
 from .errors import ProblemError
 from .hyperelastic import NeoHookean
 from .linear_solver import solve_constrained
-from .linear_static import Timer, discretise
+from .linear_static import Timer, build_configuration
 from .problem_file import Case
 from .result import Result, probe_record
 from .rpim import shape_functions
@@ -92,16 +90,10 @@ def solve_total_lagrangian(case: Case) -> Result:
         raise ProblemError("the neo-Hookean model is implemented in plane strain; set problem.plane = \"strain\"",
                            key="problem.plane")
     timer = Timer()
-    disc = discretise(case, timer)
+    conf = build_configuration(case, timer)
+    disc, rpim, sf, sf_t = conf.disc, conf.rpim, conf.sf, conf.sf_traction
     nodes, d_c, quad = disc.nodes, disc.d_c, disc.quadrature
-    tol = method.match_tolerance * d_c
-    boundary_nodes = np.unique(np.concatenate(disc.boundary.loops))
-    fixed, fixed_values = constrained_dofs(problem, nodes, boundary_nodes, tol)
-    traction_q, tx, ty = loaded_boundary(problem, nodes, disc.boundary.edges, tol)
-    rpim = dict(support_radius=method.support_radius * d_c, eta=method.eta,
-                polynomial_terms=method.polynomial_terms, scale=d_c, tree=cKDTree(nodes))
-    sf = shape_functions(nodes, quad.points, **rpim)
-    sf_t = shape_functions(nodes, traction_q.points, derivatives=False, **rpim)
+    fixed, fixed_values, traction_q, tx, ty = conf.fixed, conf.fixed_values, conf.traction, conf.tx, conf.ty
     probe_xy = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
     sf_p = shape_functions(nodes, probe_xy, **rpim) if len(probe_xy) else None
     timer.lap("shape_functions")
