@@ -82,20 +82,25 @@ def cmd_run(args: argparse.Namespace) -> int:
     paths = write_outputs(result, case, out)
     if not args.quiet:
         print(describe(result, case))
-        print("  wrote " + ", ".join(str(p) for p in paths))
+        shown = [p for p in paths if p.parent.name != "series"]
+        steps = len(paths) - len(shown)
+        print("  wrote " + ", ".join(str(p) for p in shown) + (f" ({steps} increments in series/)" if steps else ""))
     return 0
 
 
 def write_outputs(result: Result, case: Case, out: Path) -> list[Path]:
-    """summary.json and result.vtu in ``out``; both or neither (a folder this call created is removed
-    again if a write fails, so a failed run never leaves a half-written result behind)."""
-    from .output import write_summary, write_vtu
+    """result.vtu, the increment series (result.pvd + series/*.vtu) where there is one, and
+    summary.json last; all or none (a folder this call created is removed again if a write fails, so
+    a failed run never leaves a half-written result behind)."""
+    from .output import write_series, write_summary, write_vtu
 
     created = not out.exists()
     paths: list[Path] = []
     try:
-        paths.append(write_summary(result, out, case.source))
         paths.append(write_vtu(result, out))
+        for p in write_series(result, out):
+            paths.append(p)
+        paths.append(write_summary(result, out, case.source))
     except BaseException as exc:
         for p in paths:
             p.unlink(missing_ok=True)

@@ -72,16 +72,40 @@ def write_summary(result: Result, out_dir: Path, source: str) -> Path:
     return path
 
 
-def write_vtu(result: Result, out_dir: Path) -> Path:
-    """Field nodes as vertex cells with point data u and stress; boundary / elements as further cells."""
-    path = Path(out_dir) / "result.vtu"
+def _mesh(result: Result, u: np.ndarray, stress: np.ndarray, moved: bool) -> meshio.Mesh:
     n = len(result.points)
-    points = np.c_[result.points, np.zeros(n)]
+    xy = result.points + u if moved else result.points
     cells = [("vertex", np.arange(n).reshape(-1, 1))] + [(k, np.asarray(v)) for k, v in result.cells]
-    mesh = meshio.Mesh(points, cells, point_data={
-        "u": np.c_[result.u, np.zeros(n)],
-        "stress": result.stress,
-    })
+    return meshio.Mesh(np.c_[xy, np.zeros(n)], cells,
+                       point_data={"u": np.c_[u, np.zeros(n)], "stress": stress})
+
+
+def write_vtu(result: Result, out_dir: Path) -> Path:
+    """Field nodes as vertex cells with point data u and stress; boundary / elements as further cells
+    (reference configuration: warp by u in ParaView to see the deformed body)."""
+    path = Path(out_dir) / "result.vtu"
+    mesh = _mesh(result, result.u, result.stress, moved=False)
     atomic_write(path, lambda p: meshio.write(p, mesh, file_format="vtu"))
     return path
+
+
+def write_series(result: Result, out_dir: Path) -> list[Path]:
+    """One VTU per converged load increment on the *current* configuration (nodes moved by u, with
+    the tracked boundary), and ``result.pvd``, the index ParaView opens as a time series (meshio has
+    no PVD writer; DESIGN.md prefers this to XDMF for clouds whose boundary changes). The index is
+    written last, so a series is only announced once all its files exist."""
+    if not result.series:
+        return []
+    out_dir = Path(out_dir)
+    entries, written = [], []
+    for k, step in enumerate(result.series, start=1):
+        name = f"series/step_{k:04d}.vtu"
+        mesh = _mesh(result, step["u"], step["stress"], moved=True)
+        atomic_write(out_dir / name, lambda p, m=mesh: meshio.write(p, m, file_format="vtu"))
+        written.append(out_dir / name)
+        entries.append(f'    <DataSet timestep="{step["load_factor"]:.10g}" part="0" file="{name}"/>')
+    pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
+           "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
+    atomic_write_text(out_dir / "result.pvd", pvd)
+    return written + [out_dir / "result.pvd"]
 

@@ -25,6 +25,7 @@ class Result:
     parameters: dict[str, Any] = field(default_factory=dict)   # fully resolved input and derived values
     defaults: list[str] = field(default_factory=list)          # defaults that were applied
     history: list[dict[str, Any]] = field(default_factory=list)  # one entry per load increment
+    series: list[dict[str, Any]] = field(default_factory=list)   # per converged increment: load_factor, u, stress
 
 
 def probe_record(x: float, y: float, u: np.ndarray, s: np.ndarray) -> dict[str, float]:

@@ -136,6 +136,9 @@ def solve_total_lagrangian(case: Case) -> Result:
     n = len(nodes)
     U = np.zeros(2 * n)
     history: list[dict] = []
+    series: list[dict] = []
+    sf_n = shape_functions(nodes, nodes, **rpim)
+    G_nodes = gradient_operator(sf_n.dNdx, sf_n.dNdy)
     factor, dfactor, cutbacks = 0.0, 1.0 / steps, 0
     newton_iterations = 0
     while factor < 1.0 - 1e-12:
@@ -175,6 +178,7 @@ def solve_total_lagrangian(case: Case) -> Result:
         if it <= max_iterations // 2:   # an easy increment: let a cut-back step grow back towards 1/steps
             dfactor = min(2.0 * dfactor, 1.0 / steps)
         u = U.reshape(-1, 2)
+        series.append({"load_factor": factor, "u": u.copy(), "stress": _cauchy(material, G_nodes, U)})
         rec = {"load_factor": factor, "converged": True, "iterations": it}
         if sf_p is not None:
             up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
@@ -184,8 +188,7 @@ def solve_total_lagrangian(case: Case) -> Result:
     timer.lap("solve")
 
     u = U.reshape(-1, 2)
-    sf_n = shape_functions(nodes, nodes, **rpim)
-    stress = _cauchy(material, gradient_operator(sf_n.dNdx, sf_n.dNdy), U)
+    stress = series[-1]["stress"] if series else _cauchy(material, G_nodes, U)
     probes = {}
     if sf_p is not None:
         up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
@@ -199,6 +202,6 @@ def solve_total_lagrangian(case: Case) -> Result:
         counts={"nodes": n, "integration_points": len(w), "load_increments": sum(h["converged"] for h in history),
                 "cutbacks": cutbacks, "newton_iterations": newton_iterations,
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},
-        timings=timer.total(), history=history,
+        timings=timer.total(), history=history, series=series,
         parameters={**case.resolved, "derived": {"d_c": d_c, "mu": material.mu, "lambda": material.lam}},
         defaults=case.defaults)

@@ -58,7 +58,7 @@ def test_run_prints_a_summary_and_writes_both_files(run) -> None:
     assert text.startswith("cantilever (ctm-rpim): 297 nodes, d_c = 1.395")
     assert "probe tip (48, 0): ux = " in text and "error in uy" in text
     assert "relative errors: l2 " in text and "time: " in text
-    assert f"wrote {out / 'summary.json'}, {out / 'result.vtu'}" in text
+    assert f"wrote {out / 'result.vtu'}, {out / 'summary.json'}" in text
 
 
 def test_summary_holds_the_resolved_input(run) -> None:

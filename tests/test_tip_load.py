@@ -60,3 +60,23 @@ def test_inconsistent_analysis_and_material_are_errors(overrides, message: str) 
 def test_fem_reference_refuses_nonlinear_analyses() -> None:
     with pytest.raises(ProblemError, match="linear analyses only"):
         solve(benchmarks.load("tip-load"), "fem", "q1")
+
+
+def test_increment_series_round_trip(solved, tmp_path) -> None:
+    """result.pvd indexes one VTU per converged increment, on the current configuration."""
+    import xml.etree.ElementTree as ET
+
+    import meshio
+    import numpy as np
+
+    from ctmrpim.cli import write_outputs
+
+    case = benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=4"])
+    write_outputs(solved, case, tmp_path)
+    sets = ET.parse(tmp_path / "result.pvd").getroot().findall("./Collection/DataSet")
+    assert [float(d.get("timestep")) for d in sets] == pytest.approx([h["load_factor"] for h in solved.history])
+    last = meshio.read(tmp_path / sets[-1].get("file"))
+    assert np.array_equal(last.points[:, :2], solved.points + solved.u)
+    assert np.array_equal(last.point_data["u"][:, :2], solved.u)
+    assert np.array_equal(last.point_data["stress"], solved.stress)
+    assert "line" in last.cells_dict   # the boundary travels with the nodes
