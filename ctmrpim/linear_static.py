@@ -130,6 +130,7 @@ def solve_ctmrpim(case: Case) -> Result:
     D = problem.D()
     K = assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights * problem.thickness, D)
     F = assembly.load_vector(sf_t.N, traction_q.weights * problem.thickness, tx, ty)
+    F += problem.thickness * assembly.point_load_vector(nodes, problem, rpim)
     timer.lap("assembly")
 
     U = solve_constrained(K, F, fixed, fixed_values, method.solver)

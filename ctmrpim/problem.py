@@ -46,6 +46,17 @@ class Pressure:
 
 
 @dataclass(frozen=True)
+class PointLoad:
+    """A concentrated force per unit thickness at a point of the body (like a traction, it is
+    multiplied by the thickness), dead: fixed direction and size."""
+
+    x: float
+    y: float
+    fx: float = 0.0
+    fy: float = 0.0
+
+
+@dataclass(frozen=True)
 class Probe:
     name: str
     x: float
@@ -87,6 +98,7 @@ class Problem:
     tractions: list[Traction] = field(default_factory=list)
     pressures: list[Pressure] = field(default_factory=list)
     probes: list[Probe] = field(default_factory=list)
+    point_loads: list[PointLoad] = field(default_factory=list)
     exact: ExactSolution | None = None
 
     def D(self) -> np.ndarray:

@@ -24,7 +24,7 @@ from .hyperelastic import NeoHookean
 from .material import LinearElastic
 from .method import Method
 from .nodes import NodeSpec
-from .problem import Constraint, ExactSolution, Pressure, Probe, Problem, Traction
+from .problem import Constraint, ExactSolution, PointLoad, Pressure, Probe, Problem, Traction
 
 SECTIONS: dict[str, set[str] | None] = {
     "problem": {"name", "analysis", "plane", "thickness", "description"},
@@ -37,13 +37,14 @@ SECTIONS: dict[str, set[str] | None] = {
     "traction": {"where", "tx", "ty", "follower"},
     "pressure": {"where", "p"},
     "probe": {"name", "at"},
+    "point_load": {"at", "fx", "fy"},
     "exact": {"ux", "uy", "sxx", "syy", "sxy"},
     "loading": {"steps", "tolerance", "max_iterations", "max_cutbacks"},
 }
-LIST_SECTIONS = {"constraint", "traction", "pressure", "probe"}
+LIST_SECTIONS = {"constraint", "traction", "pressure", "probe", "point_load"}
 REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E", "nu"],
             "constraint": ["where"], "traction": ["where"], "pressure": ["where", "p"],
-            "probe": ["name", "at"]}
+            "probe": ["name", "at"], "point_load": ["at"]}
 #: Names people reach for instead of the file's keys, to suggest where difflib finds no close spelling.
 SYNONYMS = {"youngs": "E", "young": "E", "youngs_modulus": "E", "young_modulus": "E", "modulus": "E",
             "poisson": "nu", "poissons_ratio": "nu", "poisson_ratio": "nu", "rho": "density"}
@@ -210,15 +211,24 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     # a probe on a true arc lies up to the sagitta outside the circle's polygon
     probe_tol = (1e-9 * math.sqrt(geometry.area)
                  + 2.0 * CIRCLE_SAGITTA * max((c[2] for c in geometry.circles), default=0.0))
-    for i, c in enumerate(raw.get("probe", [])):
-        at = c["at"]
+    def point(at: Any, key: str) -> tuple[float, float]:
         if not isinstance(at, list) or len(at) != 2:
-            raise ProblemError(f"at = {at!r} must be [x, y]", key=f"probe[{i}].at")
-        probe = Probe(str(c["name"]), num(at[0], f"probe[{i}].at"), num(at[1], f"probe[{i}].at"))
+            raise ProblemError(f"at = {at!r} must be [x, y]", key=key)
+        x, y = num(at[0], key), num(at[1], key)
         # checked here, where the key is known: outside the body RPIM would fail later naming only a point
-        if geometry.distance_outside(np.array([[probe.x, probe.y]]))[0] > probe_tol:
-            raise ProblemError(f"({probe.x:g}, {probe.y:g}) lies outside the geometry", key=f"probe[{i}].at")
-        probes.append(probe)
+        if geometry.distance_outside(np.array([[x, y]]))[0] > probe_tol:
+            raise ProblemError(f"({x:g}, {y:g}) lies outside the geometry", key=key)
+        return x, y
+
+    for i, c in enumerate(raw.get("probe", [])):
+        probes.append(Probe(str(c["name"]), *point(c["at"], f"probe[{i}].at")))
+    point_loads = []
+    for i, c in enumerate(raw.get("point_load", [])):
+        if "fx" not in c and "fy" not in c:
+            raise ProblemError("give fx, fy or both", key=f"point_load[{i}]")
+        point_loads.append(PointLoad(*point(c["at"], f"point_load[{i}].at"),
+                                     fx=num(c.get("fx", 0.0), f"point_load[{i}].fx"),
+                                     fy=num(c.get("fy", 0.0), f"point_load[{i}].fy")))
     names = [p.name for p in probes]
     if len(set(names)) != len(names):
         raise ProblemError(f"probe names must be unique ({names})", key="probe")
@@ -231,7 +241,8 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
 
     problem = Problem(name=str(prob["name"]), geometry=geometry, material=material, analysis=analysis,
                       plane=plane, thickness=thickness, parameters=params, constraints=constraints,
-                      tractions=tractions, pressures=pressures, probes=probes, exact=exact)
+                      tractions=tractions, pressures=pressures, probes=probes, exact=exact,
+                      point_loads=point_loads)
 
     nodes_raw = raw.get("nodes")
     if not nodes_raw:
@@ -271,6 +282,7 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         "traction": [{k: str(v) for k, v in c.items()} for c in raw.get("traction", [])],
         "pressure": [{k: str(v) for k, v in c.items()} for c in raw.get("pressure", [])],
         "probe": [{"name": p.name, "at": [p.x, p.y]} for p in probes],
+        "point_load": [{"at": [p.x, p.y], "fx": p.fx, "fy": p.fy} for p in point_loads],
         "exact": {k: str(v) for k, v in raw.get("exact", {}).items()},
     }
     if analysis == "quasi-static":

@@ -127,9 +127,10 @@ def solve_total_lagrangian(case: Case) -> Result:
         M = np.stack([tx[:, None] * dc - ty[:, None] * ds, tx[:, None] * ds + ty[:, None] * dc], axis=1)
         M *= (follower * wt * factor)[:, None, None]
         MB = sp.bsr_matrix((M, np.arange(len(M)), np.arange(len(M) + 1)), shape=(2 * len(M), 2 * len(M)))
-        return factor * assembly.load_vector(sf_t.N, wt, rx, ry), -(Bn.T @ (MB @ Ed)).tocsr()
+        return factor * (assembly.load_vector(sf_t.N, wt, rx, ry) + F_points), -(Bn.T @ (MB @ Ed)).tocsr()
 
-    F_dead = assembly.load_vector(sf_t.N, wt, tx, ty)
+    F_points = problem.thickness * assembly.point_load_vector(nodes, problem, rpim)
+    F_dead = assembly.load_vector(sf_t.N, wt, tx, ty) + F_points
 
     timer.lap("assembly")
 

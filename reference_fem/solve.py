@@ -39,6 +39,8 @@ def solve_fem(case: Case, element: str = "q1") -> Result:
     """Solve ``case`` with the finite element ``element`` ("q1", "p1" or "p2") on its node set."""
     t0 = time.perf_counter()
     problem = case.problem
+    if problem.point_loads:
+        raise ProblemError("point loads are not supported by the FEM reference (yet)", key="point_load")
     fm = build_mesh(case, element)
     mesh = fm.mesh
     tol = case.method.match_tolerance * fm.d_c

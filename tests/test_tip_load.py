@@ -80,3 +80,11 @@ def test_increment_series_round_trip(solved, tmp_path) -> None:
     assert np.array_equal(last.point_data["u"][:, :2], solved.u)
     assert np.array_equal(last.point_data["stress"], solved.stress)
     assert "line" in last.cells_dict   # the boundary travels with the nodes
+
+
+def test_corner_load_against_the_eccentric_elastica() -> None:
+    """The paper's set-up: P at the top-right corner acts like a tip moment P (W/2) sin(theta)."""
+    r = solve(benchmarks.load("tip-load-corner", ["parameters.lam=1.8", "loading.steps=8"]))
+    w = -r.probes["tip"]["uy"] / L
+    check("tip-load-corner-tl-elastica", abs(w / elastica.tip_load_bvp(1.8, eccentricity=0.05).w_over_L - 1.0))
+    assert w > elastica.tip_load_elliptic(1.8).w_over_L   # the corner load bends more than the end shear
