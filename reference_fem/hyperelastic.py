@@ -1,0 +1,190 @@
+"""scikit-fem reference for quasi-static hyperelastic problems: total-Lagrangian Newton with load stepping.
+
+The finite element counterpart of :func:`ctmrpim.total_lagrangian.solve_total_lagrangian`: the same
+Case (neo-Hookean material in plane strain, dead tractions and pressures on the reference boundary,
+prescribed displacements scaled by the load factor) on a mesh of the same field nodes, optionally
+refined ``refine`` times for a much finer reference. Each increment is solved by Newton-Raphson with
+the meshfree solver's stopping rule (relative residual and displacement-increment norms <=
+``loading.tolerance``); an increment that does not converge is halved and retried, and the history
+says so.
+
+    f_int = t * int P_iJ(F) dv_i/dX_J dX,        K = t * int dv_i/dX_J A_iJkL(F) ddu_k/dX_L dX,
+
+with F = I + grad u, and P, A = dP/dF from :meth:`ctmrpim.hyperelastic.NeoHookean.stress_tangent`
+evaluated at the quadrature points. The Cauchy stress P F^T / J is L2-projected onto the scalar space
+for the nodal and probe values.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from scipy.sparse import csc_matrix
+from scipy.sparse.linalg import splu
+from skfem import Basis, BilinearForm, ElementVector, LinearForm, condense, solve
+
+from ctmrpim.errors import ProblemError
+from ctmrpim.hyperelastic import NeoHookean
+from ctmrpim.problem_file import Case
+from ctmrpim.result import Result, probe_record
+
+from .mesh import FemMesh, build_mesh
+from .solve import SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate
+
+#: Quadrature degree of f_int and K (P, A are not polynomial: one order above the linear need for P2).
+TANGENT_ORDER = {"q1": 2, "p1": 1, "p2": 4}
+#: Quadrature degree of the stress projection (exact mass matrices for every element).
+PROJECTION_ORDER = 4
+
+
+@BilinearForm
+def _tangent_form(u, v, w):
+    return np.einsum("iJ...,iJkL...,kL...->...", v.grad, w.A, u.grad)
+
+
+@LinearForm
+def _internal_form(v, w):
+    return np.einsum("iJ...,iJ...->...", w.P, v.grad)
+
+
+def _deformation_gradients(basis: Basis, U: np.ndarray) -> np.ndarray:
+    """F = I + grad u at the quadrature points, as (nel * nq, 2, 2)."""
+    grad = np.asarray(basis.interpolate(U).grad)                 # (2, 2, nel, nq)
+    return np.eye(2)[None] + grad.transpose(2, 3, 0, 1).reshape(-1, 2, 2)
+
+
+def _stress_tangent(material: NeoHookean, basis: Basis, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """P (2, 2, nel, nq) and A (2, 2, 2, 2, nel, nq) at the quadrature points of ``basis``."""
+    nel, nq = basis.nelems, basis.X.shape[-1]
+    P, A = material.stress_tangent(_deformation_gradients(basis, U))
+    return (P.reshape(nel, nq, 2, 2).transpose(2, 3, 0, 1),
+            A.reshape(nel, nq, 2, 2, 2, 2).transpose(2, 3, 4, 5, 0, 1))
+
+
+def _cauchy(material: NeoHookean, basis: Basis, U: np.ndarray) -> np.ndarray:
+    """(3, nel, nq) Cauchy stress sxx, syy, sxy = P F^T / J at the quadrature points of ``basis``."""
+    F = _deformation_gradients(basis, U)
+    P, _ = material.stress_tangent(F)
+    sig = P @ F.transpose(0, 2, 1) / np.linalg.det(F)[:, None, None]
+    nel, nq = basis.nelems, basis.X.shape[-1]
+    return np.stack([sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1]]).reshape(3, nel, nq)
+
+
+def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> Result:
+    """Load-stepped total-Lagrangian Newton solve of a quasi-static neo-Hookean ``case`` with the finite
+    element ``element`` ("q1", "p1" or "p2") on its node set, the mesh refined ``refine`` times."""
+    t0 = time.perf_counter()
+    problem = case.problem
+    material = problem.material
+    if problem.analysis != "quasi-static" or not isinstance(material, NeoHookean):
+        raise ProblemError("the hyperelastic FEM reference needs analysis = \"quasi-static\" and "
+                           "model = \"neo-hookean\"", key="material.model")
+    if problem.plane != "strain":
+        raise ProblemError("the neo-Hookean model is implemented in plane strain; set problem.plane = \"strain\"",
+                           key="problem.plane")
+    if element not in SCALAR_ELEMENTS:
+        raise ProblemError(f"element {element!r} is not supported (supported: {', '.join(SCALAR_ELEMENTS)})")
+    if not (isinstance(refine, int) and refine >= 0):
+        raise ProblemError(f"refine = {refine!r} must be an integer >= 0")
+    for i, tr in enumerate(problem.tractions):
+        if tr.follower:
+            raise ProblemError("follower loads are not supported by the FEM reference", key=f"traction[{i}].follower")
+    if problem.point_loads:
+        raise ProblemError("point loads are not supported by the FEM reference (yet)", key="point_load")
+    loading = case.loading
+    steps, tolerance = loading.steps, loading.tolerance
+    max_iterations, max_cutbacks = loading.max_iterations, loading.max_cutbacks
+
+    fm = build_mesh(case, element)
+    if refine:
+        mesh = fm.mesh.refined(refine)
+        fm = FemMesh(mesh, fm.nodes, fm.d_c, fm.cell_type, mesh.t.T.copy())
+    mesh = fm.mesh
+    tol = case.method.match_tolerance * fm.d_c
+    scalar_element = SCALAR_ELEMENTS[element]()
+    vec = ElementVector(scalar_element)
+    basis = Basis(mesh, vec, intorder=TANGENT_ORDER[element])
+    pbasis = Basis(mesh, vec, intorder=PROJECTION_ORDER)
+    scalar = pbasis.with_element(scalar_element)
+    t1 = time.perf_counter()
+
+    thickness = problem.thickness
+    F_dead = thickness * _load_vector(problem, fm, vec, tol, basis.N)
+    fixed, fixed_values = _constrained_dofs(problem, fm, basis, tol)
+    probe_at = [_locate(mesh, np.array([p.x, p.y]), fm.d_c, p.name) for p in problem.probes]
+    probe_u = [basis.probes(at) for at in probe_at]                  # (2, N) each
+    mass = splu(csc_matrix(BilinearForm(lambda u, v, w: u * v).assemble(scalar)))
+
+    def nodal_stress(U: np.ndarray) -> np.ndarray:
+        """(scalar.N, 3) L2 projection of the Cauchy stress."""
+        s = _cauchy(material, pbasis, U)
+        rhs = np.column_stack([LinearForm(lambda v, w: w.s * v).assemble(scalar, s=c) for c in s])
+        return mass.solve(rhs)
+
+    U = np.zeros(basis.N)
+    history: list[dict] = []
+    series: list[dict] = []
+    factor, dfactor, cutbacks, newton_iterations = 0.0, 1.0 / steps, 0, 0
+    while factor < 1.0 - 1e-12:
+        target = min(1.0, factor + dfactor)
+        trial, converged, it = U.copy(), False, 0
+        trial[fixed] = target * fixed_values
+        f_ext = target * F_dead
+        ref = max(np.linalg.norm(f_ext), 1e-30)
+        for it in range(1, max_iterations + 1):
+            try:
+                P, A = _stress_tangent(material, basis, trial)
+            except ProblemError:      # the material inverted: cut the increment back
+                break
+            residual = f_ext - thickness * _internal_form.assemble(basis, P=P)
+            residual[fixed] = 0.0
+            K = thickness * _tangent_form.assemble(basis, A=A)
+            du = solve(*condense(K, residual, D=fixed))
+            if not np.all(np.isfinite(du)):
+                raise ProblemError("the tangent stiffness is singular: the constraints do not stop every "
+                                   "rigid-body motion", key="constraint")
+            trial += du
+            newton_iterations += 1
+            if (np.linalg.norm(residual) <= tolerance * ref
+                    and np.linalg.norm(du) <= tolerance * max(np.linalg.norm(trial), 1e-30)):
+                converged = True
+                break
+        if not converged:
+            if cutbacks >= max_cutbacks:
+                raise ProblemError(f"Newton did not converge at load factor {target:.4g} after {max_cutbacks} "
+                                   "cut-backs; use more load steps", key="loading")
+            cutbacks += 1
+            dfactor *= 0.5
+            history.append({"load_factor": target, "converged": False, "iterations": it,
+                            "note": f"increment cut back to {dfactor:.4g}"})
+            continue
+        U, factor = trial, target
+        if it <= max_iterations // 2:   # an easy increment: let a cut-back step grow back towards 1/steps
+            dfactor = min(2.0 * dfactor, 1.0 / steps)
+        series.append({"load_factor": factor, "u": U[basis.nodal_dofs].T.copy(),
+                       "stress": nodal_stress(U)[scalar.nodal_dofs[0]]})
+        rec = {"load_factor": factor, "converged": True, "iterations": it}
+        for p, Pu in zip(problem.probes, probe_u):
+            up = (Pu @ U).ravel()
+            rec[p.name] = {"x": p.x, "y": p.y, "ux": float(up[0]), "uy": float(up[1])}
+        history.append(rec)
+    t2 = time.perf_counter()
+
+    stress_dofs = nodal_stress(U)
+    probes = {}
+    for p, at, Pu in zip(problem.probes, probe_at, probe_u):
+        probes[p.name] = probe_record(p.x, p.y, (Pu @ U).ravel(), (scalar.probes(at) @ stress_dofs)[0])
+    t3 = time.perf_counter()
+
+    return Result(
+        method=f"fem-{element}-tl", points=mesh.p.T.copy(), u=U[basis.nodal_dofs].T.copy(),
+        stress=stress_dofs[scalar.nodal_dofs[0]], cells=[(fm.cell_type, fm.cells)], probes=probes, errors={},
+        counts={"nodes": int(mesh.nvertices), "dofs": int(basis.N), "elements": int(mesh.nelements),
+                "integration_points": int(np.asarray(basis.dx).size),
+                "load_increments": sum(h["converged"] for h in history), "newton_iterations": newton_iterations,
+                "cutbacks": cutbacks},
+        timings={"mesh": t1 - t0, "solve": t2 - t1, "postprocess": t3 - t2, "total": t3 - t0},
+        history=history, series=series,
+        parameters={**case.resolved, "d_c": fm.d_c, "element": element, "refine": refine,
+                    "derived": {"mu": material.mu, "lambda": material.lam}},
+        defaults=list(case.defaults))
