@@ -11,9 +11,9 @@ ELEMENTS = ("q1", "p1", "p2")
 def solve(case: Case, solver: str = "ctm-rpim", element: str = "q1") -> Result:
     """Solve ``case`` with CTM-RPIM, or with scikit-fem ``element`` when ``solver == "fem"``."""
     if solver == "fem":
-        if case.problem.analysis != "linear":
-            from .errors import ProblemError
-            raise ProblemError("the scikit-fem reference solves linear analyses only (so far)", key="--solver")
+        if case.problem.analysis == "quasi-static":
+            from reference_fem.hyperelastic import solve_fem_hyperelastic
+            return solve_fem_hyperelastic(case, element)
         from reference_fem import solve_fem
         return solve_fem(case, element)
     if case.problem.analysis == "quasi-static":

@@ -1,7 +1,8 @@
 """Sweep executor: many independent cases, run locally in processes or on a Dask cluster, cached.
 
 Every case gets a folder under the sweep's root named by a hash of its *resolved* input (the full
-problem after defaults and overrides, the solver and element, the code version), holding
+problem after defaults and overrides, the solver and element, the code version and a hash of the
+solver sources, so that changed code never serves a stale cached result), holding
 ``summary.json`` and ``status.json`` (start, end, status, error). A case counts as done when its
 status is ``ok`` with the same hash: a re-run skips it, so an interrupted sweep resumes where it
 stopped; a failed case keeps its error and is retried only when asked (``retry_failed``).
@@ -18,6 +19,7 @@ import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
+from functools import cache
 from multiprocessing import get_all_start_methods, get_context
 from pathlib import Path
 from typing import Any, Iterable
@@ -41,13 +43,27 @@ class CaseSpec:
         return dict(self.labels)
 
 
+@cache
+def code_version() -> str:
+    """The package version plus a hash of the solver sources (ctmrpim and reference_fem): a change to
+    the code that computes a case makes its cached result stale, not just a change to its input."""
+    import reference_fem
+
+    digest = hashlib.sha256(__version__.encode())
+    for package in (Path(__file__).parent, Path(reference_fem.__file__).parent):
+        for f in sorted(package.rglob("*.py")):   # inputs (benchmark files) are in the resolved case already
+            digest.update(f.relative_to(package.parent).as_posix().encode())
+            digest.update(f.read_bytes())
+    return f"{__version__}+{digest.hexdigest()[:16]}"
+
+
 def case_hash(spec: CaseSpec) -> str:
     """sha256 of the resolved input, the method and the code version."""
     from .cli import load_target
 
     case = load_target(spec.target, list(spec.overrides))
     payload = {"resolved": case.resolved, "solver": spec.solver,
-               "element": spec.element if spec.solver == "fem" else None, "version": __version__}
+               "element": spec.element if spec.solver == "fem" else None, "version": code_version()}
     text = json.dumps(_jsonable(payload), sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()
 
