@@ -57,11 +57,6 @@ def test_inconsistent_analysis_and_material_are_errors(overrides, message: str) 
         benchmarks.load("tip-load", overrides)
 
 
-def test_fem_reference_refuses_nonlinear_analyses() -> None:
-    with pytest.raises(ProblemError, match="linear analyses only"):
-        solve(benchmarks.load("tip-load"), "fem", "q1")
-
-
 def test_increment_series_round_trip(solved, tmp_path) -> None:
     """result.pvd indexes one VTU per converged increment, on the current configuration."""
     import xml.etree.ElementTree as ET

@@ -1,0 +1,68 @@
+"""Deformed configurations of the large-deflection beams (paper Figs. 15 and 17): the node cloud and
+its boundary at several load levels, drawn from the per-increment series of one total-Lagrangian run
+each (these runs are not cached: they need the displacement fields, not only the summaries).
+
+Writes ``deformed_shapes.png``.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ctmrpim import benchmarks, elastica
+from ctmrpim.output import atomic_write
+from ctmrpim.solvers import solve
+
+from .base import new_figure
+
+NAME = "deformed_shapes"
+STAGES = (0.25, 0.5, 0.75, 1.0)
+
+
+def _draw(ax, result, step, colour, label):
+    xy = result.points + step["u"]
+    ax.plot(xy[:, 0], xy[:, 1], ".", ms=1.5, color=colour)
+    for a, b in next(c for k, c in result.cells if k == "line"):
+        ax.plot(xy[[a, b], 0], xy[[a, b], 1], "-", lw=0.8, color=colour)
+    ax.plot([], [], "-", color=colour, label=label)
+
+
+def run(quick: bool = True, out_dir: Path = Path("reports"), progress=print) -> Path:
+    m_full = 0.5 if quick else 1.0
+    lam = 1.8 if quick else 3.6
+    progress(f"deformed shapes: end moment up to m = {m_full}, tip load up to lambda = {lam}")
+    ring = solve(benchmarks.load("end-moment", [f"parameters.m={m_full}", f"loading.steps={int(32 * m_full)}"]))
+    tip = solve(benchmarks.load("tip-load", [f"parameters.lam={lam}", f"loading.steps={int(np.ceil(4 * lam))}"]))
+    fig, axes = new_figure(2, 5.5)
+    colours = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
+    for stage, colour in zip(STAGES, colours):
+        step = min(ring.series, key=lambda s: abs(s["load_factor"] - stage))
+        m = step["load_factor"] * m_full
+        _draw(axes[0, 0], ring, step, colour, f"M = {m:.3g} x 2 pi EI/L")
+        ex, ey = elastica.end_moment_tip(2 * np.pi * m)
+        axes[0, 0].plot(10 * ex, 10 * ey, "kx")
+        step = min(tip.series, key=lambda s: abs(s["load_factor"] - stage))
+        _draw(axes[0, 1], tip, step, colour, f"lambda = {step['load_factor'] * lam:.3g}")
+        exact = elastica.tip_load_elliptic(step["load_factor"] * lam)
+        axes[0, 1].plot(10 * (1 - exact.u_over_L), -10 * exact.w_over_L, "kx")
+    axes[0, 0].set(title="End moment (cf. Fig. 17); x: exact tip", xlabel="x", ylabel="y", aspect="equal")
+    axes[0, 1].set(title="Tip load (cf. Fig. 15); x: exact tip", xlabel="x", ylabel="y", aspect="equal")
+    for ax in axes[0]:
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    path = Path(out_dir) / f"{NAME}.png"
+    atomic_write(path, lambda p: fig.savefig(p, format="png", dpi=110))
+    import matplotlib.pyplot as plt
+    plt.close(fig)
+    return path
+
+
+if __name__ == "__main__":
+    import argparse
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--out", default="reports")
+    a = ap.parse_args()
+    print(run(a.quick, Path(a.out)))
