@@ -81,7 +81,7 @@ def test_zero_load_gives_zero_displacement() -> None:
     assert all(h["converged"] for h in r.history)
 
 
-def test_cut_back_is_reported_and_failure_is_an_error(case) -> None:
+def test_cut_back_is_reported_and_failure_is_an_error() -> None:
     r = solve_fem_hyperelastic(benchmarks.load("tip-load", [f"parameters.lam={LAM}", "loading.steps=1",
                                                             "loading.max_iterations=5"]), "q1")
     assert r.counts["cutbacks"] >= 1

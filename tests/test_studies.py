@@ -11,11 +11,28 @@ from studies import claims
 
 
 @pytest.fixture(scope="module")
-def tables(tmp_path_factory) -> dict[str, pd.DataFrame]:
+def sweep(tmp_path_factory) -> Sweep:
+    return Sweep(tmp_path_factory.mktemp("cache"), workers=2, progress=False)
+
+
+@pytest.fixture(scope="module")
+def tables(tmp_path_factory, sweep) -> dict[str, pd.DataFrame]:
     root = tmp_path_factory.mktemp("studies")
-    sweep = Sweep(root / "cache", workers=2, progress=False)
     return {name: studies.study(name).run(True, root / "reports", sweep, progress=lambda *_: None)
             for name in studies.NAMES}
+
+
+def test_quick_report(tables, sweep, tmp_path) -> None:
+    """The main job: every section and figure is written and every check passes (the studies' cases
+    come from the shared cache, so this only adds the report's own work)."""
+    from ctmrpim.report import make_report
+
+    path = make_report(quick=True, out_dir=tmp_path, sweep=sweep, progress=lambda *_: None)
+    text = path.read_text()
+    assert "FAIL" not in text
+    for name in [*studies.NAMES, "deformed_shapes"]:
+        assert f"({name}.png)" in text and (tmp_path / f"{name}.png").is_file()
+    assert sweep.computed == 0
 
 
 def test_every_case_succeeds(tables) -> None:
