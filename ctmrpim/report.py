@@ -60,7 +60,8 @@ def verification_checks(nd: pd.DataFrame, plate: pd.DataFrame, tip: pd.DataFrame
                  _row("plate-hole-ctmrpim-l2", at.loc[(plane, "ctm-rpim"), "l2_error"], f"plane {plane}"),
                  _row("plate-hole-fem-p2-energy", at.loc[(plane, "fem-p2"), "energy_error"], f"plane {plane}")]
     tip = tip[tip.status == "ok"]
-    shear, corner = tip[tip.load == "end shear"], tip[tip.load == "corner"]
+    shear = tip[(tip.load == "end shear") & (tip.method == "ctm-rpim")]
+    corner = tip[(tip.load == "corner") & (tip.method == "ctm-rpim")]
     rows += [_row("tip-load-tl-elastica", float(shear.w_rel_diff.abs().max()), "worst over the loads run"),
              _row("tip-load-tl-elastica-shortening", float(shear.u_rel_diff.abs().max()), "worst over the loads run"),
              _row("tip-load-corner-tl-elastica", float(corner.w_rel_diff.abs().max()), "worst over the loads run")]
@@ -192,7 +193,9 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     w("\n\n![tip load](tip_load.png)\n\nThe continuum beam (W/L = 0.1) is slightly more flexible than the "
       "inextensible, shear-rigid elastica: +1.1-1.2 % in w/L at every load, of which shear accounts for about "
       "0.6 % at small loads. With the paper's corner load the tip deflects 2-4 % more, and the elastica with "
-      "the matching end moment predicts exactly that: against it the offset is the same +1.1 %.\n\n")
+      "the matching end moment predicts exactly that: against it the offset is the same +1.1 %. scikit-fem P2 "
+      "on the same nodes (converged: one refinement changes w/L by 1e-5 relative) gives +0.6-1.0 % against the "
+      "elastica, so CTM-RPIM's own discretisation error is about +0.2-0.5 % of w/L at 306 nodes.\n\n")
     w("## Large deflection: end moment (cf. Figs. 16-17)\n\n")
     w(f"{studies.study('end_moment').__doc__.strip()}\n\n")
     em = tables["end_moment"].drop(columns=["status", "d_c", "tip_error", "l2_error", "energy_error", "method"],

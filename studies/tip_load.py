@@ -3,7 +3,8 @@ horizontal shortening u/L against lambda = P L^2/(E I) for the paper's loads P =
 total-Lagrangian neo-Hookean CTM-RPIM (306 nodes, mid-height tip) against the exact elastica, for
 two ways of applying P: a parabolic shear on the end face (benchmark tip-load, against the clean
 elastica) and the paper's concentrated force at the top-right corner (tip-load-corner, against the
-elastica with the matching end moment, e = W/2).
+elastica with the matching end moment, e = W/2); scikit-fem P2 (total-Lagrangian, same nodes) on the
+end-shear variant as the finite-element reference of the same continuum.
 """
 from __future__ import annotations
 
@@ -28,9 +29,17 @@ VARIANTS = {"tip-load": "end shear", "tip-load-corner": "corner"}
 
 
 def specs(quick: bool) -> list[CaseSpec]:
-    return [CaseSpec(target, (f"parameters.lam={lam!r}", f"loading.steps={max(2, int(np.ceil(4 * lam)))}"),
-                     labels=(("load", variant), ("lam", lam)))
-            for target, variant in VARIANTS.items() for lam in (QUICK if quick else FULL)]
+    lams = QUICK if quick else FULL
+
+    def overrides(lam):
+        return (f"parameters.lam={lam!r}", f"loading.steps={max(2, int(np.ceil(4 * lam)))}")
+
+    ours = [CaseSpec(target, overrides(lam), labels=(("load", variant), ("lam", lam)))
+            for target, variant in VARIANTS.items() for lam in lams]
+    # scikit-fem P2 total-Lagrangian on the same nodes (end shear only: the FEM reference has no point loads)
+    fem = [CaseSpec("tip-load", overrides(lam), "fem", "p2", labels=(("load", "end shear"), ("lam", lam)))
+           for lam in lams]
+    return ours + fem
 
 
 def extra(summary: dict) -> dict:
@@ -55,9 +64,11 @@ def figure(df: pd.DataFrame):
     ax.plot(lam, [e.w_over_L for e in ecc], "-", color="grey", label="elastica w/L, corner load")
     ok = df[df.status == "ok"]
     for variant, marker in (("end shear", "o"), ("corner", "^")):
-        d = ok[ok.load == variant]
+        d = ok[(ok.load == variant) & (ok.method == "ctm-rpim")]
         ax.plot(d.lam, d.w_over_L, marker, label=f"CTM-RPIM (TL) w/L, {variant}")
         ax.plot(d.lam, d.u_over_L, marker, mfc="none", label=f"CTM-RPIM (TL) u/L, {variant}")
+    d = ok[ok.method == "fem-p2"]
+    ax.plot(d.lam, d.w_over_L, "k+", ms=9, label="scikit-fem P2 (TL) w/L, end shear")
     ax.set(xlabel="lambda = P L^2 / (E I)", ylabel="tip displacement / L", title=TITLE)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
