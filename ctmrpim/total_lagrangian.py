@@ -154,7 +154,9 @@ def solve_total_lagrangian(case: Case) -> Result:
                 P, A = material.stress_tangent(np.eye(2)[None] + H)
             except ProblemError:
                 break
-            residual = f_ext - _internal_force(G, P, w)
+            f_int = _internal_force(G, P, w)
+            residual = f_ext - f_int
+            scale = max(ref, np.linalg.norm(f_int))   # reactions carry a displacement-driven load
             residual[fixed] = 0.0
             K = _tangent(G, A, w)
             if K_load is not None:   # follower loads make the tangent non-symmetric: no Cholesky
@@ -163,7 +165,7 @@ def solve_total_lagrangian(case: Case) -> Result:
                                    "superlu" if K_load is not None else method.solver)
             trial += du
             newton_iterations += 1
-            if np.linalg.norm(residual) <= tolerance * ref and np.linalg.norm(du) <= tolerance * max(np.linalg.norm(trial), 1e-30):
+            if np.linalg.norm(residual) <= tolerance * scale and np.linalg.norm(du) <= tolerance * max(np.linalg.norm(trial), 1e-30):
                 converged = True
                 break
         if not converged:

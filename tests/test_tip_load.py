@@ -83,3 +83,22 @@ def test_corner_load_against_the_eccentric_elastica() -> None:
     w = -r.probes["tip"]["uy"] / L
     check("tip-load-corner-tl-elastica", abs(w / elastica.tip_load_bvp(1.8, eccentricity=0.05).w_over_L - 1.0))
     assert w > elastica.tip_load_elliptic(1.8).w_over_L   # the corner load bends more than the end shear
+
+
+@pytest.mark.parametrize("solver, element", [("ctm-rpim", "q1"), ("fem", "p2")])
+def test_displacement_driven_loading_converges(solver: str, element: str) -> None:
+    """No external force at all: the prescribed tip displacement drives the beam (the Newton test is
+    relative to the reactions then)."""
+    import tomllib
+
+    import numpy as np
+
+    from ctmrpim.problem_file import parse_case
+
+    raw = tomllib.loads(benchmarks.path("tip-load").read_text())
+    raw["constraint"].append({"where": "x == L", "uy": "-2.0"})
+    case = parse_case(raw, "tip-load", benchmarks.FOLDER, ["parameters.lam=0", "loading.steps=2"])
+    r = solve(case, solver, element)
+    end = np.abs(r.points[:, 0] - L) < 1e-9
+    assert np.array_equal(r.u[end, 1], np.full(end.sum(), -2.0))
+    assert r.history[-1]["converged"] and r.history[-1]["load_factor"] == pytest.approx(1.0)
