@@ -19,6 +19,7 @@ from . import assembly
 from .errors import ProblemError
 from .hyperelastic import NeoHookean
 from .linear_solver import solve_constrained
+from .load_stepping import step_loads
 from .linear_static import Timer, build_configuration
 from .problem_file import Case
 from .result import Result, probe_record
@@ -84,8 +85,6 @@ def solve_total_lagrangian(case: Case) -> Result:
     material = problem.material
     if not isinstance(material, NeoHookean):
         raise ProblemError("the total-Lagrangian solver needs model = \"neo-hookean\"", key="material.model")
-    steps, tolerance = case.loading.steps, case.loading.tolerance
-    max_iterations, max_cutbacks = case.loading.max_iterations, case.loading.max_cutbacks
     if problem.plane != "strain":
         raise ProblemError("the neo-Hookean model is implemented in plane strain; set problem.plane = \"strain\"",
                            key="problem.plane")
@@ -135,59 +134,33 @@ def solve_total_lagrangian(case: Case) -> Result:
     timer.lap("assembly")
 
     n = len(nodes)
-    U = np.zeros(2 * n)
-    history: list[dict] = []
     series: list[dict] = []
     sf_n = shape_functions(nodes, nodes, **rpim)
     G_nodes = gradient_operator(sf_n.dNdx, sf_n.dNdy)
-    factor, dfactor, cutbacks = 0.0, 1.0 / steps, 0
-    newton_iterations = 0
-    while factor < 1.0 - 1e-12:
-        target = min(1.0, factor + dfactor)
-        trial, converged, it = U.copy(), False, 0
-        trial[fixed] = target * fixed_values
-        ref = max(np.linalg.norm(external(trial, target)[0]), 1e-30)
-        for it in range(1, max_iterations + 1):
-            f_ext, K_load = external(trial, target)
-            H = (G @ trial).reshape(-1, 2, 2)
-            try:
-                P, A = material.stress_tangent(np.eye(2)[None] + H)
-            except ProblemError:
-                break
-            f_int = _internal_force(G, P, w)
-            residual = f_ext - f_int
-            scale = max(ref, np.linalg.norm(f_int))   # reactions carry a displacement-driven load
-            residual[fixed] = 0.0
-            K = _tangent(G, A, w)
-            if K_load is not None:   # follower loads make the tangent non-symmetric: no Cholesky
-                K = K + K_load
-            du = solve_constrained(K, residual, fixed, np.zeros(len(fixed)),
-                                   "superlu" if K_load is not None else method.solver)
-            trial += du
-            newton_iterations += 1
-            if np.linalg.norm(residual) <= tolerance * scale and np.linalg.norm(du) <= tolerance * max(np.linalg.norm(trial), 1e-30):
-                converged = True
-                break
-        if not converged:
-            if cutbacks >= max_cutbacks:
-                raise ProblemError(f"Newton did not converge at load factor {target:.4g} after {max_cutbacks} "
-                                   "cut-backs; use more load steps", key="loading")
-            cutbacks += 1
-            dfactor *= 0.5
-            history.append({"load_factor": target, "converged": False, "iterations": it,
-                            "note": f"increment cut back to {dfactor:.4g}"})
-            continue
-        U, factor = trial, target
-        if it <= max_iterations // 2:   # an easy increment: let a cut-back step grow back towards 1/steps
-            dfactor = min(2.0 * dfactor, 1.0 / steps)
+
+    def assemble(U: np.ndarray, factor: float):
+        f_ext, K_load = external(U, factor)
+        P, A = material.stress_tangent(np.eye(2)[None] + (G @ U).reshape(-1, 2, 2))
+        K = _tangent(G, A, w)
+        return f_ext, _internal_force(G, P, w), (K if K_load is None else K + K_load)
+
+    # follower loads make the tangent non-symmetric: no Cholesky then
+    linear_solver = "superlu" if follower.any() else method.solver
+
+    def solve(K, residual):
+        return solve_constrained(K, residual, fixed, np.zeros(len(fixed)), linear_solver)
+
+    def on_converged(factor: float, U: np.ndarray) -> dict:
         u = U.reshape(-1, 2)
         series.append({"load_factor": factor, "u": u.copy(), "stress": _cauchy(material, G_nodes, U)})
-        rec = {"load_factor": factor, "converged": True, "iterations": it}
-        if sf_p is not None:
-            up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
-            for i, p in enumerate(problem.probes):
-                rec[p.name] = {"x": p.x, "y": p.y, "ux": float(up[i, 0]), "uy": float(up[i, 1])}
-        history.append(rec)
+        if sf_p is None:
+            return {}
+        up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
+        return {p.name: {"x": p.x, "y": p.y, "ux": float(up[i, 0]), "uy": float(up[i, 1])}
+                for i, p in enumerate(problem.probes)}
+
+    path = step_loads(2 * n, case.loading, fixed, fixed_values, assemble, solve, on_converged)
+    U, history = path.U, path.history
     timer.lap("solve")
 
     u = U.reshape(-1, 2)
@@ -203,7 +176,7 @@ def solve_total_lagrangian(case: Case) -> Result:
         method="ctm-rpim-tl", points=nodes, u=u, stress=stress,
         cells=[("line", disc.boundary.edges)], probes=probes, errors={},
         counts={"nodes": n, "integration_points": len(w), "load_increments": sum(h["converged"] for h in history),
-                "cutbacks": cutbacks, "newton_iterations": newton_iterations,
+                "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},
         timings=timer.total(), history=history, series=series,
         parameters={**case.resolved, "derived": {"d_c": d_c, "mu": material.mu, "lambda": material.lam}},

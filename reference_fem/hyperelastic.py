@@ -3,10 +3,8 @@
 The finite element counterpart of :func:`ctmrpim.total_lagrangian.solve_total_lagrangian`: the same
 Case (neo-Hookean material in plane strain, dead tractions and pressures on the reference boundary,
 prescribed displacements scaled by the load factor) on a mesh of the same field nodes, optionally
-refined ``refine`` times for a much finer reference. Each increment is solved by Newton-Raphson with
-the meshfree solver's stopping rule (relative residual and displacement-increment norms <=
-``loading.tolerance``); an increment that does not converge is halved and retried, and the history
-says so.
+refined ``refine`` times for a much finer reference. Loads are stepped by the same driver as the
+meshfree solver (:func:`ctmrpim.load_stepping.step_loads`: Newton-Raphson, reported cut-backs).
 
     f_int = t * int P_iJ(F) dv_i/dX_J dX,        K = t * int dv_i/dX_J A_iJkL(F) ddu_k/dX_L dX,
 
@@ -25,6 +23,7 @@ from skfem import Basis, BilinearForm, ElementVector, LinearForm, condense, solv
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.hyperelastic import NeoHookean
+from ctmrpim.load_stepping import step_loads
 from ctmrpim.problem_file import Case
 from ctmrpim.result import Result, probe_record
 
@@ -91,9 +90,6 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
             raise ProblemError("follower loads are not supported by the FEM reference", key=f"traction[{i}].follower")
     if problem.point_loads:
         raise ProblemError("point loads are not supported by the FEM reference (yet)", key="point_load")
-    loading = case.loading
-    steps, tolerance = loading.steps, loading.tolerance
-    max_iterations, max_cutbacks = loading.max_iterations, loading.max_cutbacks
 
     fm = build_mesh(case, element)
     if refine:
@@ -121,55 +117,27 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
         rhs = np.column_stack([LinearForm(lambda v, w: w.s * v).assemble(scalar, s=c) for c in s])
         return mass.solve(rhs)
 
-    U = np.zeros(basis.N)
-    history: list[dict] = []
     series: list[dict] = []
-    factor, dfactor, cutbacks, newton_iterations = 0.0, 1.0 / steps, 0, 0
-    while factor < 1.0 - 1e-12:
-        target = min(1.0, factor + dfactor)
-        trial, converged, it = U.copy(), False, 0
-        trial[fixed] = target * fixed_values
-        f_ext = target * F_dead
-        ref = max(np.linalg.norm(f_ext), 1e-30)
-        for it in range(1, max_iterations + 1):
-            try:
-                P, A = _stress_tangent(material, basis, trial)
-            except ProblemError:      # the material inverted: cut the increment back
-                break
-            f_int = thickness * _internal_form.assemble(basis, P=P)
-            residual = f_ext - f_int
-            scale = max(ref, np.linalg.norm(f_int))   # reactions carry a displacement-driven load
-            residual[fixed] = 0.0
-            K = thickness * _tangent_form.assemble(basis, A=A)
-            du = solve(*condense(K, residual, D=fixed))
-            if not np.all(np.isfinite(du)):
-                raise ProblemError("the tangent stiffness is singular: the constraints do not stop every "
-                                   "rigid-body motion", key="constraint")
-            trial += du
-            newton_iterations += 1
-            if (np.linalg.norm(residual) <= tolerance * scale
-                    and np.linalg.norm(du) <= tolerance * max(np.linalg.norm(trial), 1e-30)):
-                converged = True
-                break
-        if not converged:
-            if cutbacks >= max_cutbacks:
-                raise ProblemError(f"Newton did not converge at load factor {target:.4g} after {max_cutbacks} "
-                                   "cut-backs; use more load steps", key="loading")
-            cutbacks += 1
-            dfactor *= 0.5
-            history.append({"load_factor": target, "converged": False, "iterations": it,
-                            "note": f"increment cut back to {dfactor:.4g}"})
-            continue
-        U, factor = trial, target
-        if it <= max_iterations // 2:   # an easy increment: let a cut-back step grow back towards 1/steps
-            dfactor = min(2.0 * dfactor, 1.0 / steps)
+
+    def assemble(U: np.ndarray, factor: float):
+        P, A = _stress_tangent(material, basis, U)      # an inverted material cuts the increment back
+        return (factor * F_dead, thickness * _internal_form.assemble(basis, P=P),
+                thickness * _tangent_form.assemble(basis, A=A))
+
+    def solve_increment(K, residual):
+        return solve(*condense(K, residual, D=fixed))
+
+    def on_converged(factor: float, U: np.ndarray) -> dict:
         series.append({"load_factor": factor, "u": U[basis.nodal_dofs].T.copy(),
                        "stress": nodal_stress(U)[scalar.nodal_dofs[0]]})
-        rec = {"load_factor": factor, "converged": True, "iterations": it}
+        out = {}
         for p, Pu in zip(problem.probes, probe_u):
             up = (Pu @ U).ravel()
-            rec[p.name] = {"x": p.x, "y": p.y, "ux": float(up[0]), "uy": float(up[1])}
-        history.append(rec)
+            out[p.name] = {"x": p.x, "y": p.y, "ux": float(up[0]), "uy": float(up[1])}
+        return out
+
+    path = step_loads(basis.N, case.loading, fixed, fixed_values, assemble, solve_increment, on_converged)
+    U, history = path.U, path.history
     t2 = time.perf_counter()
 
     stress_dofs = nodal_stress(U)
@@ -183,8 +151,8 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
         stress=stress_dofs[scalar.nodal_dofs[0]], cells=[(fm.cell_type, fm.cells)], probes=probes, errors={},
         counts={"nodes": int(mesh.nvertices), "dofs": int(basis.N), "elements": int(mesh.nelements),
                 "integration_points": int(np.asarray(basis.dx).size),
-                "load_increments": sum(h["converged"] for h in history), "newton_iterations": newton_iterations,
-                "cutbacks": cutbacks},
+                "load_increments": sum(h["converged"] for h in history), "newton_iterations": path.newton_iterations,
+                "cutbacks": path.cutbacks},
         timings={"mesh": t1 - t0, "solve": t2 - t1, "postprocess": t3 - t2, "total": t3 - t0},
         history=history, series=series,
         parameters={**case.resolved, "d_c": fm.d_c, "element": element, "refine": refine,
