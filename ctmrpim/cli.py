@@ -133,7 +133,7 @@ def cmd_study(args: argparse.Namespace) -> int:
                                f"available: {', '.join(studies.ALIASES)} or all")
     sweep = _sweep(args)
     for name in names:
-        df = studies.study(name).run(args.quick, Path(args.out), sweep)
+        df = studies.run(name, args.quick, Path(args.out), sweep)
         print(df.drop(columns=[c for c in ("status",) if c in df]).to_string(index=False))
     return 0
 

@@ -99,7 +99,7 @@ def _md(df: pd.DataFrame) -> str:
 def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Sweep | None = None,
                 progress=print) -> Path:
     out_dir = Path(out_dir)
-    tables = {name: studies.study(name).run(quick, out_dir, sweep, progress) for name in studies.NAMES}
+    tables = {name: studies.run(name, quick, out_dir, sweep, progress) for name in studies.NAMES}
     nd, plate = tables["node_density"], tables["plate_hole_convergence"]
     checks = verification_checks(nd, plate, tables["tip_load"], tables["end_moment"])
     claim_rows = claims_table(tables)

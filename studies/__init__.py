@@ -6,7 +6,10 @@ or ``ctmrpim study NAME [--quick]``), sends its cases through the sweep executor
 from __future__ import annotations
 
 from importlib import import_module
+from pathlib import Path
 from types import ModuleType
+
+import pandas as pd
 
 NAMES = ["node_density", "integration_density", "support_radius", "shape_parameter", "parameter_map",
          "time_to_accuracy", "plate_hole_convergence", "tip_load", "end_moment"]
@@ -16,3 +19,9 @@ ALIASES = {n.replace("_", "-"): n for n in NAMES}
 
 def study(name: str) -> ModuleType:
     return import_module(f"studies.{ALIASES.get(name, name)}")
+
+
+def run(name: str, quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
+    """Run study ``name`` through the sweep executor; its table (also written as CSV and PNG)."""
+    from .base import run_study
+    return run_study(study(name), quick, out_dir, sweep, progress)

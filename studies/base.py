@@ -2,7 +2,7 @@
 
 A study module defines ``NAME``, ``TITLE``, ``specs(quick) -> list[CaseSpec]`` (each spec labelled
 with the study's coordinates), ``figure(table) -> Figure`` and optionally ``extra(summary) -> dict``
-for columns of its own; :func:`run_study` does the rest.
+for columns of its own; :func:`run_study` (or ``studies.run(name)``) does the rest.
 """
 from __future__ import annotations
 
@@ -58,10 +58,26 @@ def run_study(module: ModuleType, quick: bool = True, out_dir: Path = Path("repo
     out_dir = Path(out_dir)
     atomic_write_text(out_dir / f"{module.NAME}.csv", df.to_csv(index=False))
     fig = module.figure(df)
-    atomic_write(out_dir / f"{module.NAME}.png", lambda p: fig.savefig(p, format="png", dpi=110))
-    import matplotlib.pyplot as plt
-    plt.close(fig)
+    save_figure(fig, out_dir / f"{module.NAME}.png")
     return df
+
+
+def save_figure(fig, path: Path) -> Path:
+    """Write a figure as PNG atomically and release it."""
+    import matplotlib.pyplot as plt
+
+    atomic_write(path, lambda p: fig.savefig(p, format="png", dpi=110))
+    plt.close(fig)
+    return path
+
+
+def finished(fig, axes, which: str = "major", fontsize: int = 8):
+    """The common finish of a study figure: grid and legend on every axis, tight layout."""
+    for ax in axes.ravel():
+        ax.grid(True, which=which, alpha=0.3)
+        ax.legend(fontsize=fontsize)
+    fig.tight_layout()
+    return fig
 
 
 def new_figure(ncols: int = 1, width: float = 5.5):

@@ -11,10 +11,9 @@ from pathlib import Path
 import numpy as np
 
 from ctmrpim import benchmarks, elastica
-from ctmrpim.output import atomic_write
 from ctmrpim.solvers import solve
 
-from .base import new_figure
+from .base import finished, new_figure, save_figure
 
 NAME = "deformed_shapes"
 STAGES = (0.25, 0.5, 0.75, 1.0)
@@ -48,15 +47,8 @@ def run(quick: bool = True, out_dir: Path = Path("reports"), progress=print) -> 
         axes[0, 1].plot(10 * (1 - exact.u_over_L), -10 * exact.w_over_L, "kx")
     axes[0, 0].set(title="End moment (cf. Fig. 17); x: exact tip", xlabel="x", ylabel="y", aspect="equal")
     axes[0, 1].set(title="Tip load (cf. Fig. 15); x: exact tip", xlabel="x", ylabel="y", aspect="equal")
-    for ax in axes[0]:
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    path = Path(out_dir) / f"{NAME}.png"
-    atomic_write(path, lambda p: fig.savefig(p, format="png", dpi=110))
-    import matplotlib.pyplot as plt
-    plt.close(fig)
-    return path
+    finished(fig, axes, "major", 7)
+    return save_figure(fig, Path(out_dir) / f"{NAME}.png")
 
 
 if __name__ == "__main__":

@@ -6,7 +6,6 @@ ring. At m = 1 the exact beam closes into a circle of radius L / (2 pi).
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -14,7 +13,7 @@ import pandas as pd
 from ctmrpim import elastica
 from ctmrpim.sweep import CaseSpec
 
-from .base import new_figure, run_study
+from .base import finished, new_figure
 
 NAME = "end_moment"
 TITLE = "End moment: tip against the exact arc (cf. Figs. 16-17)"
@@ -50,16 +49,9 @@ def figure(df: pd.DataFrame):
     for _, r in ok.iterrows():
         ax.annotate(f"m = {r.m:g}", (r.x_over_L, r.y_over_L), textcoords="offset points", xytext=(6, 4), fontsize=8)
     ax.set(xlabel="x / L", ylabel="y / L", title=TITLE, aspect="equal")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
-
-
-def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
-    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
+    return finished(fig, axes)
 
 
 if __name__ == "__main__":
     from .cli import main
-    main(run, __doc__)
+    main(sys.modules[__name__])

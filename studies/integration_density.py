@@ -5,13 +5,11 @@ claims the error falls roughly exponentially in d_c/r and is satisfactory from d
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import pandas as pd
 
 from ctmrpim.sweep import CaseSpec
 
-from .base import run_study
 from .one_parameter import cantilever_specs, error_plot
 
 NAME = "integration_density"
@@ -33,10 +31,6 @@ def figure(df: pd.DataFrame):
     return error_plot(df, PARAMETER, "d_c / r", TITLE, PAPER_RANGE)
 
 
-def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
-    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
-
-
 if __name__ == "__main__":
     from .cli import main
-    main(run, __doc__)
+    main(sys.modules[__name__])

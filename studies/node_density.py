@@ -8,13 +8,12 @@ the r_c = 2 d_c / two-point setting printed beside Fig. 9 (1-1.8 % at 33 x 9, no
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import pandas as pd
 
 from ctmrpim.sweep import CaseSpec
 
-from .base import new_figure, run_study
+from .base import finished, new_figure
 from .fitting import fitted_rate
 
 NAME = "node_density"
@@ -51,17 +50,9 @@ def figure(df: pd.DataFrame):
         axes[0, 1].loglog(d.nodes, d.energy_error, "o-", label=method)
     axes[0, 0].set(xlabel="nodes", ylabel="relative tip-deflection error", title="Cantilever tip error (cf. Fig. 9b)")
     axes[0, 1].set(xlabel="nodes", ylabel="relative energy-norm error", title="Energy-norm error")
-    for ax in axes[0]:
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
-
-
-def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
-    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
+    return finished(fig, axes, "both", 8)
 
 
 if __name__ == "__main__":
     from .cli import main
-    main(run, __doc__)
+    main(sys.modules[__name__])

@@ -5,7 +5,7 @@ import pandas as pd
 
 from ctmrpim.sweep import CaseSpec
 
-from .base import new_figure
+from .base import finished, new_figure
 
 
 def cantilever_specs(parameter: str, values: list[float], grids: list[tuple[int, int]],
@@ -25,7 +25,4 @@ def error_plot(df: pd.DataFrame, parameter: str, xlabel: str, title: str, band: 
     if band:
         ax.axvspan(*band, color="green", alpha=0.1, label="paper's recommended range")
     ax.set(xlabel=xlabel, ylabel="relative error [%]", title=title)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
+    return finished(fig, axes, "both")

@@ -5,14 +5,13 @@ whether the paper's one-at-a-time recommendations (r_c = 3.5-4 d_c, eta = 4.5-7.
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ctmrpim.sweep import CaseSpec
 
-from .base import new_figure, run_study
+from .base import new_figure
 
 NAME = "parameter_map"
 TITLE = "Tip error over r_c and eta (17 x 5)"
@@ -42,10 +41,6 @@ def figure(df: pd.DataFrame):
     return fig
 
 
-def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
-    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
-
-
 if __name__ == "__main__":
     from .cli import main
-    main(run, __doc__)
+    main(sys.modules[__name__])

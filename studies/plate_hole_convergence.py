@@ -5,7 +5,6 @@ concentration sxx(0, a) (exact 3 T) read at the boundary node.
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import pandas as pd
 
@@ -13,7 +12,7 @@ from ctmrpim import benchmarks
 from ctmrpim.problem_file import Case
 from ctmrpim.sweep import CaseSpec
 
-from .base import new_figure, run_study
+from .base import finished, new_figure
 
 NAME = "plate_hole_convergence"
 TITLE = "Plate with a hole (Kirsch)"
@@ -49,17 +48,9 @@ def figure(df: pd.DataFrame):
     axes[0, 1].axhline(3.0, color="k", lw=0.8, label="exact 3 T")
     axes[0, 0].set(xlabel="nodes", ylabel="relative energy-norm error", title=TITLE + ": energy error")
     axes[0, 1].set(xlabel="nodes", ylabel="sxx(0, a) / T", title="Stress concentration at the hole")
-    for ax in axes[0]:
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    return fig
-
-
-def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
-    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
+    return finished(fig, axes, "both", 7)
 
 
 if __name__ == "__main__":
     from .cli import main
-    main(run, __doc__)
+    main(sys.modules[__name__])

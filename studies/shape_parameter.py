@@ -4,13 +4,11 @@ r_c = 4 d_c. The paper claims eta in [3.5, 9.5] is accurate and [4.5, 7.5] low a
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import pandas as pd
 
 from ctmrpim.sweep import CaseSpec
 
-from .base import run_study
 from .one_parameter import cantilever_specs, error_plot
 
 NAME = "shape_parameter"
@@ -32,10 +30,6 @@ def figure(df: pd.DataFrame):
     return error_plot(df, PARAMETER, "eta", TITLE, PAPER_RANGE)
 
 
-def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
-    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
-
-
 if __name__ == "__main__":
     from .cli import main
-    main(run, __doc__)
+    main(sys.modules[__name__])

@@ -6,14 +6,13 @@ core (the sweep executor's workers), so the times compare.
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ctmrpim.sweep import CaseSpec
 
-from .base import new_figure, run_study
+from .base import finished, new_figure
 
 NAME = "time_to_accuracy"
 TITLE = "Time to accuracy (cantilever tip error)"
@@ -65,16 +64,9 @@ def figure(df: pd.DataFrame):
     from matplotlib.ticker import LogFormatterSciNotation, NullFormatter
     ax.xaxis.set_major_formatter(LogFormatterSciNotation())
     ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
-
-
-def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
-    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
+    return finished(fig, axes, "both")
 
 
 if __name__ == "__main__":
     from .cli import main
-    main(run, __doc__)
+    main(sys.modules[__name__])

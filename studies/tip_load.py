@@ -9,7 +9,6 @@ end-shear variant as the finite-element reference of the same continuum.
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -17,7 +16,7 @@ import pandas as pd
 from ctmrpim import elastica
 from ctmrpim.sweep import CaseSpec
 
-from .base import new_figure, run_study
+from .base import finished, new_figure
 
 NAME = "tip_load"
 TITLE = "Tip-loaded cantilever against the elastica (cf. Fig. 14)"
@@ -70,16 +69,9 @@ def figure(df: pd.DataFrame):
     d = ok[ok.method == "fem-p2"]
     ax.plot(d.lam, d.w_over_L, "k+", ms=9, label="scikit-fem P2 (TL) w/L, end shear")
     ax.set(xlabel="lambda = P L^2 / (E I)", ylabel="tip displacement / L", title=TITLE)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    return fig
-
-
-def run(quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
-    return run_study(sys.modules[__name__], quick, out_dir, sweep, progress)
+    return finished(fig, axes)
 
 
 if __name__ == "__main__":
     from .cli import main
-    main(run, __doc__)
+    main(sys.modules[__name__])

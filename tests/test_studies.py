@@ -18,7 +18,7 @@ def sweep(tmp_path_factory) -> Sweep:
 @pytest.fixture(scope="module")
 def tables(tmp_path_factory, sweep) -> dict[str, pd.DataFrame]:
     root = tmp_path_factory.mktemp("studies")
-    return {name: studies.study(name).run(True, root / "reports", sweep, progress=lambda *_: None)
+    return {name: studies.run(name, True, root / "reports", sweep, progress=lambda *_: None)
             for name in studies.NAMES}
 
 
