@@ -26,7 +26,7 @@ from typing import Any, Iterable
 
 from . import __version__
 from .errors import ProblemError
-from .output import _jsonable, atomic_write_text, summary_dict
+from .output import _jsonable, atomic_write_text, write_summary
 
 
 @dataclass(frozen=True)
@@ -114,8 +114,7 @@ def run_case(spec: CaseSpec, folder: str, key: str, worker: bool = True) -> dict
         case = load_target(spec.target, list(spec.overrides))
         with threadpool_limits(1):
             result = solve(case, spec.solver, spec.element)
-        atomic_write_text(folder_path / "summary.json",
-                          json.dumps(_jsonable(summary_dict(result, case.source)), indent=1) + "\n")
+        write_summary(result, folder_path, case.source)
         status.update(status="ok")
     except ProblemError as exc:
         status.update(status="error", error=exc.message)
