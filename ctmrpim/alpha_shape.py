@@ -68,8 +68,14 @@ def circumradii(points: np.ndarray, tri: np.ndarray) -> np.ndarray:
         return np.where(area2 > 0, la * lb * lc / (2.0 * area2), np.inf)
 
 
-def alpha_shape(points: np.ndarray, alpha: float, d_c: float) -> Boundary:
-    """Tracked boundary of ``points`` for an absolute alpha radius (paper Section 2.4)."""
+def alpha_shape(points: np.ndarray, alpha: float, d_c: float, reference: np.ndarray | None = None,
+                max_reference_edge: float | None = None) -> Boundary:
+    """Tracked boundary of ``points`` for an absolute alpha radius (paper Section 2.4).
+
+    On a deformed cloud, ``reference`` (the nodes' reference positions) and ``max_reference_edge``
+    also drop every triangle with an edge longer than that in the reference configuration: nodes
+    that were far apart (the two ends of a beam rolled into a ring) are never joined into the body.
+    """
     points = np.asarray(points, dtype=float)
     if len(points) < 3:
         raise ProblemError(f"alpha shape: {len(points)} node(s) cannot enclose an area")
@@ -82,6 +88,10 @@ def alpha_shape(points: np.ndarray, alpha: float, d_c: float) -> Boundary:
     cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
     tri[cw] = tri[cw][:, [0, 2, 1]]
     keep = circumradii(points, tri) < alpha
+    if reference is not None and max_reference_edge is not None:
+        r = np.asarray(reference, float)[tri]
+        longest = np.max(np.linalg.norm(r - np.roll(r, 1, axis=1), axis=2), axis=1)
+        keep &= longest <= max_reference_edge
     if not keep.any():
         raise ProblemError(f"alpha shape: alpha = {alpha:g} keeps no triangle; increase method.alpha")
 

@@ -37,6 +37,14 @@ class NeoHookean:
     def lam(self) -> float:
         return self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
 
+    def first_piola(self, F: np.ndarray) -> np.ndarray:
+        """P (m, 2, 2) at F (m, 2, 2), without the inversion check: analytic in F, so that a complex
+        step through it gives exact derivatives (the updated-Lagrangian tangent)."""
+        J = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
+        FinvT = np.stack([np.stack([F[:, 1, 1], -F[:, 1, 0]], -1), np.stack([-F[:, 0, 1], F[:, 0, 0]], -1)], 1)
+        FinvT = FinvT / J[:, None, None]
+        return self.mu * F + (self.lam * np.log(J) - self.mu)[:, None, None] * FinvT
+
     def stress_tangent(self, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """P (m, 2, 2) and A (m, 2, 2, 2, 2) at deformation gradients F (m, 2, 2)."""
         J = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]

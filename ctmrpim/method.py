@@ -10,6 +10,8 @@ from .errors import ProblemError
 POLYNOMIAL_TERMS = {"linear": 3, "quadratic": 6}
 BOUNDARIES = ("alpha", "geometry")
 SOLVERS = ("auto", "banded", "superlu", "spsolve")
+#: large-deformation (quasi-static) formulations: the paper's adaptive one, and the cross-check
+FORMULATIONS = ("updated-lagrangian", "total-lagrangian")
 
 
 def mean_node_spacing(area: float, n_nodes: int) -> float:
@@ -30,6 +32,7 @@ class Method:
     boundary: str = "alpha"              # integrate over the tracked alpha shape, or the exact geometry
     solver: str = "auto"                 # linear solver: auto, banded (RCM + Cholesky), superlu, spsolve
     match_tolerance: float = 0.01        # '==' tolerance in `where` selectors / d_c
+    formulation: str = "total-lagrangian"  # quasi-static: updated-lagrangian (adaptive) or total-lagrangian
 
     def __post_init__(self) -> None:
         self.line_spacing = tuple(float(v) for v in self.line_spacing)
@@ -48,6 +51,7 @@ class Method:
             ("boundary", self.boundary in BOUNDARIES, f"must be one of {list(BOUNDARIES)}"),
             ("solver", self.solver in SOLVERS, f"must be one of {list(SOLVERS)}"),
             ("match_tolerance", 0 < self.match_tolerance < 0.5, "must lie in (0, 0.5)"),
+            ("formulation", self.formulation in FORMULATIONS, f"must be one of {list(FORMULATIONS)}"),
         ]
         for key, ok, why in checks:
             if not ok:

@@ -72,10 +72,12 @@ def write_summary(result: Result, out_dir: Path, source: str) -> Path:
     return path
 
 
-def _mesh(result: Result, u: np.ndarray, stress: np.ndarray, moved: bool) -> meshio.Mesh:
+def _mesh(result: Result, u: np.ndarray, stress: np.ndarray, moved: bool,
+          boundary: np.ndarray | None = None) -> meshio.Mesh:
     n = len(result.points)
     xy = result.points + u if moved else result.points
-    cells = [("vertex", np.arange(n).reshape(-1, 1))] + [(k, np.asarray(v)) for k, v in result.cells]
+    blocks = result.cells if boundary is None else [("line", boundary)]
+    cells = [("vertex", np.arange(n).reshape(-1, 1))] + [(k, np.asarray(v)) for k, v in blocks]
     return meshio.Mesh(np.c_[xy, np.zeros(n)], cells,
                        point_data={"u": np.c_[u, np.zeros(n)], "stress": stress})
 
@@ -91,7 +93,7 @@ def write_vtu(result: Result, out_dir: Path) -> Path:
 
 def write_series(result: Result, out_dir: Path) -> list[Path]:
     """One VTU per converged load increment on the *current* configuration (nodes moved by u, with
-    the tracked boundary), and ``result.pvd``, the index ParaView opens as a time series (meshio has
+    the boundary tracked on it where the solver re-tracks, else the reference one moved), and ``result.pvd``, the index ParaView opens as a time series (meshio has
     no PVD writer; DESIGN.md prefers this to XDMF for clouds whose boundary changes). The index is
     written last, so a series is only announced once all its files exist."""
     if not result.series:
@@ -100,7 +102,7 @@ def write_series(result: Result, out_dir: Path) -> list[Path]:
     entries, written = [], []
     for k, step in enumerate(result.series, start=1):
         name = f"series/step_{k:04d}.vtu"
-        mesh = _mesh(result, step["u"], step["stress"], moved=True)
+        mesh = _mesh(result, step["u"], step["stress"], moved=True, boundary=step.get("boundary"))
         atomic_write(out_dir / name, lambda p, m=mesh: meshio.write(p, m, file_format="vtu"))
         written.append(out_dir / name)
         entries.append(f'    <DataSet timestep="{step["load_factor"]:.10g}" part="0" file="{name}"/>')

@@ -50,8 +50,8 @@ SYNONYMS = {"youngs": "E", "young": "E", "youngs_modulus": "E", "young_modulus":
             "poisson": "nu", "poissons_ratio": "nu", "poisson_ratio": "nu", "rho": "density"}
 ANALYSES = ("linear", "quasi-static")
 MATERIAL_MODELS = ("linear-elastic", "neo-hookean")
-#: the material model each analysis solves
-ANALYSIS_MODEL = {"linear": "linear-elastic", "quasi-static": "neo-hookean"}
+#: the material models each analysis solves (quasi-static linear-elastic: the updated-Lagrangian rate form)
+ANALYSIS_MODELS = {"linear": ("linear-elastic",), "quasi-static": ("neo-hookean", "linear-elastic")}
 
 
 @dataclass(frozen=True)
@@ -174,9 +174,9 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     if mat.get("model") not in MATERIAL_MODELS:
         raise ProblemError(f"model {mat.get('model')!r} is not supported (supported: {', '.join(MATERIAL_MODELS)})",
                            key="material.model")
-    if mat["model"] != ANALYSIS_MODEL[analysis]:
-        raise ProblemError(f"analysis {analysis!r} needs model = {ANALYSIS_MODEL[analysis]!r}, not {mat['model']!r}",
-                           key="material.model")
+    if mat["model"] not in ANALYSIS_MODELS[analysis]:
+        raise ProblemError(f"analysis {analysis!r} needs model = {' or '.join(map(repr, ANALYSIS_MODELS[analysis]))}, "
+                           f"not {mat['model']!r}", key="material.model")
     material = LinearElastic(E=num(mat["E"], "material.E"), nu=num(mat["nu"], "material.nu"),
                              density=num(get("material", "density", 0.0), "material.density"))
     if mat["model"] == "neo-hookean":
@@ -268,6 +268,10 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
             raise ProblemError(f"{v!r} must be an integer", key="method.gauss_points")
         kwargs[key] = v
     method = Method(**kwargs)
+    if analysis == "quasi-static" and mat["model"] == "linear-elastic" and method.formulation == "total-lagrangian":
+        raise ProblemError("the total-Lagrangian formulation needs model = 'neo-hookean' (a linear-elastic "
+                           "material at large deformation is a rate law: method.formulation = "
+                           "\"updated-lagrangian\")", key="material.model")
 
     resolved = {
         "problem": {"name": problem.name, "analysis": analysis, "plane": plane, "thickness": thickness},

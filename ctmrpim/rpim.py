@@ -64,11 +64,16 @@ def _polynomial(x: np.ndarray, y: np.ndarray, m: int) -> np.ndarray:
 
 def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float, eta: float,
                     polynomial_terms: int, scale: float, derivatives: bool = True,
-                    tree: cKDTree | None = None) -> ShapeFunctions:
+                    tree: cKDTree | None = None,
+                    reference: tuple[np.ndarray, np.ndarray, float] | None = None) -> ShapeFunctions:
     """RPIM shape functions (Eqs. 25-34) of ``nodes`` at ``points``.
 
     ``support_radius`` and ``scale`` (d_c) are absolute lengths. A point whose support holds fewer
     nodes than the polynomial needs, or whose moment matrix is singular, is an error naming it.
+    ``reference = (node_positions, point_positions, distance)`` on a deformed cloud drops from a
+    support every node farther than ``distance`` from the point in the reference configuration, so
+    that parts of the body that were far apart (the two ends of a beam rolled into a ring) never
+    share shape functions when they come close.
     """
     nodes = np.asarray(nodes, float)
     points = np.asarray(points, float)
@@ -90,8 +95,9 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
 
     def work(ab):
         sel = order[ab[0]:ab[1]]
+        ref = None if reference is None else (reference[0], reference[1][sel], reference[2])
         return _chunk(nodes, points[sel], sel, tree, int(counts[sel].max()), support_radius, eta, m, scale,
-                      derivatives)
+                      derivatives, ref)
 
     # each small LAPACK solve runs on one thread; BLAS threads on top of ours would only contend
     with threadpool_limits(limits=1, user_api="blas"):
@@ -121,11 +127,21 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
     return ShapeFunctions(N=mats[0], dNdx=mats[1], dNdy=mats[2], support_sizes=counts)
 
 
-def _chunk(nodes, pts, point_ids, tree, k, radius, eta, m, scale, derivatives):
+def _chunk(nodes, pts, point_ids, tree, k, radius, eta, m, scale, derivatives, reference=None):
     dist, idx = tree.query(pts, k=k, distance_upper_bound=radius)
     dist = dist.reshape(len(pts), k)
     idx = idx.reshape(len(pts), k)
     valid = np.isfinite(dist)
+    if reference is not None:
+        node_ref, point_ref, far = reference
+        gap = node_ref[np.where(valid, idx, 0)] - point_ref[:, None, :]
+        valid &= np.einsum("cid,cid->ci", gap, gap) <= far * far
+        few = valid.sum(axis=1) < m + 1
+        if few.any():
+            i = int(np.flatnonzero(few)[0])
+            raise ProblemError(f"RPIM: point #{point_ids[i]} at ({pts[i, 0]:.6g}, {pts[i, 1]:.6g}) keeps "
+                               f"{int(valid[i].sum())} node(s) of its support that were its neighbours in the "
+                               "reference configuration; increase method.support_radius")
     vf = valid.astype(float)
     local = (nodes[np.where(valid, idx, 0)] - pts[:, None, :]) / scale   # (c, k, 2), evaluation point at origin
     local *= vf[..., None]

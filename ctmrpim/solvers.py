@@ -17,6 +17,9 @@ def solve(case: Case, solver: str = "ctm-rpim", element: str = "q1") -> Result:
         from reference_fem import solve_fem
         return solve_fem(case, element)
     if case.problem.analysis == "quasi-static":
+        if case.method.formulation == "updated-lagrangian":
+            from .updated_lagrangian import solve_updated_lagrangian
+            return solve_updated_lagrangian(case)
         from .total_lagrangian import solve_total_lagrangian
         return solve_total_lagrangian(case)
     from .linear_static import solve_ctmrpim

@@ -1,0 +1,61 @@
+"""Sparse operators of the large-deformation (Lagrangian) forms of CTM-RPIM, Section 2.1.3.
+
+Both the total-Lagrangian solver (gradients on the reference configuration) and the updated-Lagrangian
+one (gradients on the configuration of the last rebuild) write the internal force and its tangent on
+a fixed configuration X with the first Piola-Kirchhoff stress P relative to it:
+
+    F_int[I, i] = sum_p w_p P_iJ(p) dN_I/dX_J(p)                    (G^T (w P))
+    K[(I, i), (K, k)] = sum_p w_p dN_I/dX_J A_iJkL dN_K/dX_L         (G^T diag(w A) G)
+
+with A = dP/dF. Components are flattened as c = 2 i + J (xX, xY, yX, yY); dofs are interleaved.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+
+def gradient_operator(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix) -> sp.csr_matrix:
+    """G (4m x 2n): row 4p + c, c = xX, xY, yX, yY, gives du_i/dX_J at point p from interleaved dofs.
+    ``dNdx`` and ``dNdy`` share one sparsity pattern (they come from one RPIM solve)."""
+    m, n = dNdx.shape
+    counts = np.repeat(np.diff(dNdx.indptr), 4)                  # each point's support, once per row c
+    indptr = np.concatenate([[0], np.cumsum(counts)])
+    gather = np.repeat(np.repeat(dNdx.indptr[:-1], 4) - indptr[:-1], counts) + np.arange(indptr[-1])
+    c = np.repeat(np.tile(np.arange(4), m), counts)
+    data = np.where(c % 2 == 0, dNdx.data[gather], dNdy.data[gather])   # J = X for c = 0, 2
+    indices = 2 * dNdx.indices[gather] + (c >= 2)                      # i = y for c = 2, 3
+    return sp.csr_matrix((data, indices, indptr), shape=(4 * m, 2 * n))
+
+
+def value_operator(N: sp.csr_matrix) -> sp.csr_matrix:
+    """(2m x 2n): rows (p, i) give u_i at point p from interleaved dofs."""
+    m, n = N.shape
+    counts = np.repeat(np.diff(N.indptr), 2)
+    indptr = np.concatenate([[0], np.cumsum(counts)])
+    gather = np.repeat(np.repeat(N.indptr[:-1], 2) - indptr[:-1], counts) + np.arange(indptr[-1])
+    i = np.repeat(np.tile(np.arange(2), m), counts)
+    return sp.csr_matrix((N.data[gather], 2 * N.indices[gather] + i, indptr), shape=(2 * m, 2 * n))
+
+
+def difference_operator(ends: np.ndarray, n_nodes: int) -> sp.csr_matrix:
+    """(2m x 2n): rows (p, j) give u_j(end 1) - u_j(end 0) of the segment point p lies on."""
+    m = len(ends)
+    rows = np.repeat(np.arange(2 * m), 2)
+    j = np.tile(np.repeat(np.arange(2), 2), m)
+    cols = 2 * np.stack([ends[:, 1], ends[:, 0]], axis=1).repeat(2, axis=0).ravel() + j
+    vals = np.tile([1.0, -1.0], 2 * m)
+    return sp.csr_matrix((vals, (rows, cols)), shape=(2 * m, 2 * n_nodes))
+
+
+def internal_force(G: sp.csr_matrix, P: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """G^T (w P): P (m, 4) or (m, 2, 2)."""
+    return G.T @ (P.reshape(-1, 4) * w[:, None]).ravel()
+
+
+def tangent(G: sp.csr_matrix, A: np.ndarray, w: np.ndarray) -> sp.csr_matrix:
+    """G^T diag(w A) G: A (m, 4, 4) or (m, 2, 2, 2, 2), blocks of dP/dF."""
+    m = len(w)
+    blocks = A.reshape(m, 4, 4) * w[:, None, None]
+    WA = sp.bsr_matrix((blocks, np.arange(m), np.arange(m + 1)), shape=(4 * m, 4 * m))
+    return (G.T @ (WA @ G)).tocsr()
