@@ -32,7 +32,7 @@ class Method:
     boundary: str = "alpha"              # integrate over the tracked alpha shape, or the exact geometry
     solver: str = "auto"                 # linear solver: auto, banded (RCM + Cholesky), superlu, spsolve
     match_tolerance: float = 0.01        # '==' tolerance in `where` selectors / d_c
-    formulation: str = "total-lagrangian"  # quasi-static: updated-lagrangian (adaptive) or total-lagrangian
+    formulation: str = "updated-lagrangian"  # quasi-static: the paper's adaptive one, or total-lagrangian
 
     def __post_init__(self) -> None:
         self.line_spacing = tuple(float(v) for v in self.line_spacing)

@@ -45,7 +45,7 @@ from .linear_solver import solve_constrained
 from .linear_static import Configuration, Timer, build_configuration
 from .load_stepping import step_loads
 from .material import LinearElastic
-from .objective_stress import (DeformationGradientUpdate, HypoelasticUpdate, complex_step_tangent, det2,
+from .objective_stress import (LeftCauchyGreenUpdate, HypoelasticUpdate, complex_step_tangent, det2,
                                inv2)
 from .problem_file import Case
 from .result import Result, probe_record
@@ -66,7 +66,7 @@ def stress_update(case: Case):
         if problem.plane != "strain":
             raise ProblemError("the neo-Hookean model is implemented in plane strain; set problem.plane = \"strain\"",
                                key="problem.plane")
-        return DeformationGradientUpdate(material)
+        return LeftCauchyGreenUpdate(material)
     if isinstance(material, LinearElastic):
         return HypoelasticUpdate(problem.D(), problem.plane)
     raise ProblemError(f"the updated-Lagrangian solver has no stress update for {type(material).__name__}",
@@ -99,6 +99,7 @@ class AdaptiveBody:
         method = case.method
         self.case, self.X, self.d_c, self.update, self.traction, self.timer = case, X, d_c, update, traction, timer
         self.x = X.copy()
+        self.U = np.zeros(X.size)                    # total displacement, interleaved
         self.alpha = method.alpha * d_c
         self.r_x, self.r_y = (s * d_c for s in method.line_spacing)
         self.rpim = dict(support_radius=method.support_radius * d_c, eta=method.eta,
@@ -185,8 +186,9 @@ class AdaptiveBody:
     def relative_gradient(self, du: np.ndarray) -> np.ndarray:
         return np.eye(2)[None] + (self.G @ du).reshape(-1, 2, 2)
 
-    def trial(self, du: np.ndarray, factor: float) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix]:
-        """F_ext, F_int and the tangent at the displacement increment ``du`` (interleaved)."""
+    def trial(self, U: np.ndarray, factor: float) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix]:
+        """F_ext, F_int and the tangent at the total displacement ``U`` (interleaved)."""
+        du = U - self.U
         f = self.relative_gradient(du)
         J = det2(f)
         if np.any(J <= 0):
@@ -198,20 +200,22 @@ class AdaptiveBody:
         K = tangent(self.G, A, self.w)
         return f_ext, internal_force(self.G, P, self.w), (K if K_load is None else K + K_load)
 
-    def commit(self, du: np.ndarray, rebuild: bool = True) -> str | None:
+    def commit(self, U: np.ndarray, rebuild: bool = True) -> str | None:
         """Accept the increment: advance the state, move nodes and points, re-track, rebuild, transfer.
 
         Without ``rebuild`` (the last increment), or when the re-tracking cannot separate parts of the
         body that have come into contact (nodes left out of the alpha shape, or an area jump), the
         points move with the body and keep their shape functions, the gradients mapped to the new
         configuration (grad N_{n+1} = grad N_n f^-1, w_{n+1} = w_n det f); the reason is returned so
-        the history can say so."""
+        the history can say so. ``U`` is the total displacement (interleaved)."""
+        du = U - self.U
         f = self.relative_gradient(du)
         state = self.update.advance(f, self.state)
         d = du.reshape(-1, 2)
         w_moved = self.w * det2(f)
         N_old = self.sf.N
-        self.x = self.x + d
+        self.U = U.copy()
+        self.x = self.X + U.reshape(-1, 2)       # from the total, so prescribed values come out exact
         self.material_x = self.material_x + np.c_[self.N_material @ d[:, 0], self.N_material @ d[:, 1]]
         self.timer.lap("solve")
         skipped = None
@@ -246,7 +250,7 @@ class AdaptiveBody:
 
     @property
     def u(self) -> np.ndarray:
-        return self.x - self.X
+        return self.U.reshape(-1, 2).copy()
 
     def stress_nodes(self) -> np.ndarray:
         return self.update.cauchy(self.nodal_state)
@@ -291,10 +295,6 @@ def solve_updated_lagrangian(case: Case) -> Result:
     n = len(X)
     fixed, fixed_values = conf.fixed, conf.fixed_values
     series: list[dict] = []
-    U_n = np.zeros(2 * n)
-
-    def assemble(U: np.ndarray, factor: float):
-        return body.trial(U - U_n, factor)
 
     def solve(K, residual):   # the rate-form and follower tangents are not symmetric
         return solve_constrained(K, residual, fixed, np.zeros(len(fixed)), "superlu")
@@ -305,17 +305,15 @@ def solve_updated_lagrangian(case: Case) -> Result:
                 for i, p in enumerate(problem.probes)}
 
     def on_converged(factor: float, U: np.ndarray) -> dict:
-        nonlocal U_n
         # nothing is solved on the final configuration: no rebuild there (at the full end moment the
         # tip face touches the root face, where no alpha shape separates them)
-        skipped = body.commit(U - U_n, rebuild=factor < 1.0 - 1e-12)
-        U_n = body.u.ravel().copy()
+        skipped = body.commit(U, rebuild=factor < 1.0 - 1e-12)
         series.append({"load_factor": factor, "u": body.u.copy(), "stress": body.stress_nodes(),
                        "boundary": body.boundary.edges.copy()})
         return {**probe_values(), "tracked_area": body.areas[-1], "boundary_loops": len(body.boundary.loops),
                 **({"note": skipped} if skipped else {})}
 
-    path = step_loads(2 * n, case.loading, fixed, fixed_values, assemble, solve, on_converged)
+    path = step_loads(2 * n, case.loading, fixed, fixed_values, body.trial, solve, on_converged)
     history = path.history
 
     probes = {}

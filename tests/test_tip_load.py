@@ -10,11 +10,12 @@ from ctmrpim.errors import ProblemError
 from ctmrpim.solvers import solve
 
 L = 10.0
+TL = 'method.formulation="total-lagrangian"'
 
 
 @pytest.fixture(scope="module")
 def solved():
-    return solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=4"]))
+    return solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=4", TL]))
 
 
 def test_tip_deflection_against_the_elastica(solved) -> None:
@@ -35,7 +36,7 @@ def test_history_has_every_increment(solved) -> None:
 
 
 def test_cut_back_is_reported_not_silent() -> None:
-    r = solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=1", "loading.max_iterations=6"]))
+    r = solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=1", "loading.max_iterations=6", TL]))
     assert r.counts["cutbacks"] >= 1
     assert any(not h["converged"] and "cut back" in h["note"] for h in r.history)
     assert r.history[-1]["load_factor"] == pytest.approx(1.0)
@@ -66,7 +67,7 @@ def test_increment_series_round_trip(solved, tmp_path) -> None:
 
     from ctmrpim.cli import write_outputs
 
-    case = benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=4"])
+    case = benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=4", TL])
     write_outputs(solved, case, tmp_path)
     sets = ET.parse(tmp_path / "result.pvd").getroot().findall("./Collection/DataSet")
     assert [float(d.get("timestep")) for d in sets] == pytest.approx([h["load_factor"] for h in solved.history])
@@ -79,7 +80,7 @@ def test_increment_series_round_trip(solved, tmp_path) -> None:
 
 def test_corner_load_against_the_eccentric_elastica() -> None:
     """The paper's set-up: P at the top-right corner acts like a tip moment P (W/2) sin(theta)."""
-    r = solve(benchmarks.load("tip-load-corner", ["parameters.lam=1.8", "loading.steps=8"]))
+    r = solve(benchmarks.load("tip-load-corner", ["parameters.lam=1.8", "loading.steps=8", TL]))
     w = -r.probes["tip"]["uy"] / L
     check("tip-load-corner-tl-elastica", abs(w / elastica.tip_load_bvp(1.8, eccentricity=0.05).w_over_L - 1.0))
     assert w > elastica.tip_load_elliptic(1.8).w_over_L   # the corner load bends more than the end shear
