@@ -55,6 +55,7 @@ def solve_total_lagrangian(case: Case) -> Result:
     sf_p = shape_functions(nodes, probe_xy, **rpim) if len(probe_xy) else None
     timer.lap("shape_functions")
     G = gradient_operator(sf.dNdx, sf.dNdy)
+    GT = G.T
     w = quad.weights * problem.thickness
     wt = traction_q.weights * problem.thickness
     follower = traction_q.follower
@@ -72,8 +73,8 @@ def solve_total_lagrangian(case: Case) -> Result:
     def assemble(U: np.ndarray, factor: float):
         f_ext, K_load = loads.forces(nodes + U.reshape(-1, 2), factor)
         P, A = material.stress_tangent(np.eye(2)[None] + (G @ U).reshape(-1, 2, 2))
-        K = tangent(G, A, w)
-        return f_ext, internal_force(G, P, w), (K if K_load is None else K + K_load)
+        K = tangent(G, A, w, GT)
+        return f_ext, internal_force(G, P, w, GT), (K if K_load is None else K + K_load)
 
     # follower loads make the tangent non-symmetric: no Cholesky then
     linear_solver = "superlu" if follower.any() else method.solver

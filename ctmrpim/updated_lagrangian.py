@@ -179,6 +179,7 @@ class AdaptiveBody:
         self.areas.append(area)
         self.points, self.w = quad.points, quad.weights * self.thickness
         self.G = gradient_operator(sf.dNdx, sf.dNdy)
+        self.GT = self.G.T
         self.loads = BoundaryLoads(Nt, tr.weights, tr.tx, tr.ty, tr.ends, tr.follower, tr.d0, F_points)
         self.timer.lap("shape_functions")
 
@@ -197,8 +198,8 @@ class AdaptiveBody:
         P = self.update.first_piola(f, self.state)
         A = complex_step_tangent(self.update, f, self.state)
         f_ext, K_load = self.loads.forces(self.x + du.reshape(-1, 2), factor)
-        K = tangent(self.G, A, self.w)
-        return f_ext, internal_force(self.G, P, self.w), (K if K_load is None else K + K_load)
+        K = tangent(self.G, A, self.w, self.GT)
+        return f_ext, internal_force(self.G, P, self.w, self.GT), (K if K_load is None else K + K_load)
 
     def commit(self, U: np.ndarray, rebuild: bool = True) -> str | None:
         """Accept the increment: advance the state, move nodes and points, re-track, rebuild, transfer.
@@ -247,6 +248,7 @@ class AdaptiveBody:
         self.sf.dNdx = sp.csr_matrix((data_x, dx.indices, dx.indptr), shape=dx.shape)
         self.sf.dNdy = sp.csr_matrix((data_y, dx.indices, dx.indptr), shape=dx.shape)
         self.G = gradient_operator(self.sf.dNdx, self.sf.dNdy)
+        self.GT = self.G.T
 
     @property
     def u(self) -> np.ndarray:
