@@ -54,6 +54,15 @@ def describe(result: Result, case: Case) -> str:
     if "l2" in result.errors or "energy" in result.errors:
         lines.append("  relative errors: " + ", ".join(
             f"{k} {100 * result.errors[k]:.4g} %" for k in ("l2", "energy") if k in result.errors))
+    if "load_increments" in c:
+        line = (f"  {c['load_increments']} load increments, {c['newton_iterations']} Newton iterations, "
+                f"{c['cutbacks']} cut-back(s)")
+        if "rebuilds" in c:
+            line += f", {c['rebuilds']} rebuilds (boundary re-tracked, CTM and RPIM rebuilt)"
+        lines.append(line)
+        for h in result.history:
+            if "note" in h:
+                lines.append(f"  note at load factor {h['load_factor']:.4g}: {h['note']}")
     phases = ", ".join(f"{k.replace('_', ' ')} {v:.3f}" for k, v in t.items() if k != "total")
     lines.append(f"  time: {t['total']:.3f} s ({phases})")
     return "\n".join(lines)

@@ -13,12 +13,16 @@ Raphson solves F_ext - F_int = 0 for the displacement increment du with
 P_n = det f sigma f^-T the first Piola-Kirchhoff stress relative to x_n, f = I + d(du)/dx_n. This is
 F_int = sum_p w_{n+1} sigma grad N_{n+1} on x_{n+1} (grad N_{n+1} = grad N_n f^-1, w_{n+1} = w_n det f)
 written without a rebuild. The stress update is objective (:mod:`ctmrpim.objective_stress`: Hughes-
-Winget rotation for the rate form of linear elasticity, the total deformation gradient for neo-
-Hookean) and the tangent its exact derivative, geometric part included.
+Winget rotation for the rate form of linear elasticity, the left Cauchy-Green tensor for neo-
+Hookean) and the tangent its exact derivative (complex steps), geometric part included.
 
 Where state lives (DESIGN.md): at the integration points. On a rebuild it is L2-projected onto the
 nodes over the old points and evaluated at the new points (:mod:`ctmrpim.state_transfer`); the
-number of transfers is reported. Tags are fixed on the reference configuration: constrained dofs,
+number of transfers is reported. After the last increment nothing is rebuilt (nothing is solved
+there), and where the alpha shape cannot separate parts that touch (the tip face reaching the root
+at the full end moment) the rebuild is skipped and the history says so: the points then move with
+the body and keep their shape functions, which is exact (it is the total-Lagrangian form relative
+to the last rebuild). Tags are fixed on the reference configuration: constrained dofs,
 loaded boundary segments (node pairs, each Gauss point at its fraction along its segment), probes
 and point loads (material points, carried by the RPIM interpolation of du). Alpha triangles and RPIM
 supports only join nodes that were neighbours in the reference configuration (within 2 alpha and 2
@@ -45,7 +49,7 @@ from .linear_solver import solve_constrained
 from .linear_static import Configuration, Timer, build_configuration
 from .load_stepping import step_loads
 from .material import LinearElastic
-from .objective_stress import (LeftCauchyGreenUpdate, HypoelasticUpdate, complex_step_tangent, det2,
+from .objective_stress import (HypoelasticUpdate, LeftCauchyGreenUpdate, complex_step_tangent, det2,
                                inv2)
 from .problem_file import Case
 from .result import Result, probe_record
@@ -59,8 +63,8 @@ REFERENCE_NEIGHBOURS = 2.0
 
 
 def stress_update(case: Case):
-    """The objective update of the case's material: neo-Hookean by its deformation gradient, linear
-    elasticity as a Hughes-Winget rate law."""
+    """The objective update of the case's material: neo-Hookean by its left Cauchy-Green tensor,
+    linear elasticity as a Hughes-Winget rate law."""
     material, problem = case.problem.material, case.problem
     if isinstance(material, NeoHookean):
         if problem.plane != "strain":
