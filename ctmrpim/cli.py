@@ -58,7 +58,8 @@ def describe(result: Result, case: Case) -> str:
         line = (f"  {c['load_increments']} load increments, {c['newton_iterations']} Newton iterations, "
                 f"{c['cutbacks']} cut-back(s)")
         if "rebuilds" in c:
-            line += f", {c['rebuilds']} rebuilds (boundary re-tracked, CTM and RPIM rebuilt)"
+            line += (f", {c['rebuilds']} rebuilds (boundary re-tracked, RPIM rebuilt; {c['state_transfers']} with new "
+                     "CTM points and the state transferred)")
         lines.append(line)
         for h in result.history:
             if "note" in h:

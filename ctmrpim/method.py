@@ -33,6 +33,8 @@ class Method:
     solver: str = "auto"                 # linear solver: auto, banded (RCM + Cholesky), superlu, spsolve
     match_tolerance: float = 0.01        # '==' tolerance in `where` selectors / d_c
     formulation: str = "updated-lagrangian"  # quasi-static: the paper's adaptive one, or total-lagrangian
+    point_regeneration: float = 0.0      # UL: lay new CTM points once a point is strained by more than
+                                         # this since they were laid; 0 = every increment (the paper)
 
     def __post_init__(self) -> None:
         self.line_spacing = tuple(float(v) for v in self.line_spacing)
@@ -52,6 +54,7 @@ class Method:
             ("solver", self.solver in SOLVERS, f"must be one of {list(SOLVERS)}"),
             ("match_tolerance", 0 < self.match_tolerance < 0.5, "must lie in (0, 0.5)"),
             ("formulation", self.formulation in FORMULATIONS, f"must be one of {list(FORMULATIONS)}"),
+            ("point_regeneration", self.point_regeneration >= 0, "must be >= 0 (0: every increment)"),
         ]
         for key, ok, why in checks:
             if not ok:

@@ -262,7 +262,7 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
             if not isinstance(v, list) or len(v) != 2:
                 raise ProblemError(f"{v!r} must be [r_x, r_y]", key="method.line_spacing")
             v = tuple(num(e, "method.line_spacing") for e in v)
-        elif key in ("support_radius", "eta", "alpha", "match_tolerance"):
+        elif key in ("support_radius", "eta", "alpha", "match_tolerance", "point_regeneration"):
             v = num(v, f"method.{key}")
         elif key == "gauss_points" and (isinstance(v, bool) or not isinstance(v, int)):
             raise ProblemError(f"{v!r} must be an integer", key="method.gauss_points")

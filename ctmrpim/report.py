@@ -69,6 +69,8 @@ def verification_checks(nd: pd.DataFrame, plate: pd.DataFrame, tip: pd.DataFrame
                  _row(f"tip-load-corner-{f}-elastica", float(corner.w_rel_diff.abs().max()), "worst over the loads run")]
         em = moment[(moment.status == "ok") & np.isclose(moment.m, 0.25) & (moment.formulation == f.upper())]
         rows.append(_row(f"end-moment-{f}-quarter", float(em.tip_distance_over_L.iloc[0])))
+    em = moment[(moment.status == "ok") & np.isclose(moment.m, 0.25) & (moment.formulation == "UL carried")]
+    rows.append(_row("end-moment-ul-carried-quarter", float(em.tip_distance_over_L.iloc[0])))
     return pd.DataFrame(rows)
 
 

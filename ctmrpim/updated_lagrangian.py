@@ -117,9 +117,11 @@ class AdaptiveBody:
         self.transfers = 0
         self.skipped_rebuilds = 0
         self.areas: list[float] = []
+        self.regeneration = method.point_regeneration
         self._build()
         self.state = update.initial(len(self.w))
         self.nodal_state = update.initial(len(X))
+        self.strained = np.tile(np.eye(2), (len(self.w), 1, 1))   # deformation since the points were laid
 
     # -- configuration -------------------------------------------------------------------------------
     def _track(self) -> tuple[Boundary, float]:
@@ -160,16 +162,22 @@ class AdaptiveBody:
         lam = np.stack([l0[rows, best], l1[rows, best], l2[rows, best]], axis=1)
         return np.einsum("pk,pkd->pd", lam, self.X[t])
 
-    def _build(self) -> None:
-        """Everything on the current node positions; all or nothing (a failure changes no attribute)."""
+    def _build(self, carried: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> None:
+        """Everything on the current node positions; all or nothing (a failure changes no attribute).
+        New CTM points over the re-tracked boundary, or, with ``carried = (points, weights, reference
+        positions)``, the integration points the body carried through the increment."""
         boundary, area = self._track()
         self.timer.lap("boundary")
-        quad = integration_points(boundary.loop_coordinates(), self.r_x, self.r_y,
-                                  self.case.method.gauss_points, mode="uniform")
+        if carried is None:
+            quad = integration_points(boundary.loop_coordinates(), self.r_x, self.r_y,
+                                      self.case.method.gauss_points, mode="uniform")
+            points, w = quad.points, quad.weights * self.thickness
+            ref = self._reference_positions(points, boundary)
+        else:
+            points, w, ref = carried
         self.timer.lap("integration")
         tree = cKDTree(self.x)
-        ref = self._reference_positions(quad.points, boundary)
-        sf = shape_functions(self.x, quad.points, tree=tree, reference=(self.X, ref, self.far), **self.rpim)
+        sf = shape_functions(self.x, points, tree=tree, reference=(self.X, ref, self.far), **self.rpim)
         tr = self.traction
         Nt = shape_functions(self.x, tr.positions(self.x), derivatives=False, tree=tree,
                              reference=(self.X, tr.positions(self.X), self.far), **self.rpim).N
@@ -181,7 +189,7 @@ class AdaptiveBody:
             if len(self.point_forces) else np.zeros(2 * len(self.x))
         self.boundary, self.sf, self.N_material = boundary, sf, N_material
         self.areas.append(area)
-        self.points, self.w = quad.points, quad.weights * self.thickness
+        self.points, self.w, self.points_X = points, w, ref
         self.G = gradient_operator(sf.dNdx, sf.dNdy)
         self.GT = self.G.T
         self.loads = BoundaryLoads(Nt, tr.weights, tr.tx, tr.ty, tr.ends, tr.follower, tr.d0, F_points)
@@ -206,8 +214,12 @@ class AdaptiveBody:
         return f_ext, internal_force(self.G, P, self.w, self.GT), (K if K_load is None else K + K_load)
 
     def commit(self, U: np.ndarray, rebuild: bool = True) -> str | None:
-        """Accept the increment: advance the state, move nodes and points, re-track, rebuild, transfer.
+        """Accept the increment: advance the state, move nodes and points, re-track, rebuild.
 
+        The CTM points are laid anew over the re-tracked boundary (and the state transferred to them)
+        every increment, or, with ``method.point_regeneration = s > 0``, only once a point has been
+        strained by more than s since the points were laid; until then the points move with the body
+        and keep their state, and only the boundary and the RPIM shape functions are rebuilt.
         Without ``rebuild`` (the last increment), or when the re-tracking cannot separate parts of the
         body that have come into contact (nodes left out of the alpha shape, or an area jump), the
         points move with the body and keep their shape functions, the gradients mapped to the new
@@ -219,24 +231,31 @@ class AdaptiveBody:
         d = du.reshape(-1, 2)
         w_moved = self.w * det2(f)
         N_old = self.sf.N
+        moved = self.points + np.c_[N_old @ d[:, 0], N_old @ d[:, 1]]
+        strained = f @ self.strained
         self.U = U.copy()
         self.x = self.X + U.reshape(-1, 2)       # from the total, so prescribed values come out exact
         self.material_x = self.material_x + np.c_[self.N_material @ d[:, 0], self.N_material @ d[:, 1]]
         self.timer.lap("solve")
         skipped = None
         if rebuild:
+            regenerate = self.regeneration == 0.0 or _largest_strain(strained) > self.regeneration
             try:
-                self._build()
+                self._build(None if regenerate else (moved, w_moved, self.points_X))
             except ProblemError as err:
                 skipped = f"rebuild skipped, the previous points carried: {err}"
             else:
                 self.rebuilds += 1
-                self.state, self.nodal_state = transfer(N_old, w_moved, state, self.sf.N)
-                self.transfers += 1
+                if regenerate:
+                    self.state, self.nodal_state = transfer(N_old, w_moved, state, self.sf.N)
+                    self.strained = np.tile(np.eye(2), (len(self.w), 1, 1))
+                    self.transfers += 1
+                else:
+                    self.state, self.strained = state, strained
+                    self.nodal_state = project_to_nodes(self.sf.N, self.w, state)
                 self.timer.lap("transfer")
                 return None
-        self.points = self.points + np.c_[N_old @ d[:, 0], N_old @ d[:, 1]]
-        self.state, self.w = state, w_moved
+        self.points, self.state, self.w, self.strained = moved, state, w_moved, strained
         self._map_gradients(f)
         self.nodal_state = project_to_nodes(N_old, w_moved, state)
         self.skipped_rebuilds += skipped is not None
@@ -260,6 +279,14 @@ class AdaptiveBody:
 
     def stress_nodes(self) -> np.ndarray:
         return self.update.cauchy(self.nodal_state)
+
+
+def _largest_strain(F: np.ndarray) -> float:
+    """Largest |principal stretch - 1| over deformation gradients (m, 2, 2)."""
+    C = F.transpose(0, 2, 1) @ F
+    mean, half = 0.5 * (C[:, 0, 0] + C[:, 1, 1]), np.hypot(0.5 * (C[:, 0, 0] - C[:, 1, 1]), C[:, 0, 1])
+    stretches = np.sqrt(np.c_[mean + half, np.maximum(mean - half, 0.0)])
+    return float(np.abs(stretches - 1.0).max()) if len(F) else 0.0
 
 
 def _traction_tags(conf, thickness: float) -> TractionTags:

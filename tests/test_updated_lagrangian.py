@@ -195,3 +195,27 @@ def test_series_carries_the_tracked_boundary(tmp_path) -> None:
     first = meshio.read(tmp_path / sets[0].get("file"))
     assert np.array_equal(first.cells_dict["line"], r.series[0]["boundary"])
     assert np.allclose(first.points[:, :2], r.points + r.series[0]["u"])
+
+
+def test_carried_points_keep_their_state() -> None:
+    """method.point_regeneration above the strain reached: no new CTM points, no state transfer, the
+    boundary and the RPIM shape functions still rebuilt every increment."""
+    from verify import check
+
+    from ctmrpim import benchmarks, elastica
+    from ctmrpim.solvers import solve
+
+    r = solve(benchmarks.load("end-moment", ["parameters.m=0.25", "loading.steps=16", UL,
+                                             "method.point_regeneration=0.5"]))
+    assert r.counts["rebuilds"] == 15 and r.counts["state_transfers"] == 0
+    x, y = 1.0 + r.probes["tip"]["ux"] / L, r.probes["tip"]["uy"] / L
+    ex, ey = elastica.end_moment_tip(2 * np.pi * 0.25)
+    check("end-moment-ul-carried-quarter", float(np.hypot(x - ex, y - ey)))
+
+
+def test_points_are_laid_anew_once_strained_past_the_threshold() -> None:
+    from ctmrpim import benchmarks
+    from ctmrpim.solvers import solve
+
+    r = solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=6", UL, "method.point_regeneration=0.02"]))
+    assert r.counts["rebuilds"] == 5 and 0 < r.counts["state_transfers"] < 5
