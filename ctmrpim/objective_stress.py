@@ -16,13 +16,11 @@ gradient f = I + L:
   (sxx, syy, sxy, szz); szz follows the plane-strain increment (zero in plane stress).
 * :class:`LeftCauchyGreenUpdate` (neo-Hookean in updated form): the state is the left Cauchy-Green
   tensor, b_{n+1} = f b_n f^T, and the stress the hyperelastic one of b; objective by construction.
-  b is transferred across rebuilds like any state. It is I plus strain-sized terms in the current
-  frame, so the projection's error is small against the strain. Two other states were tried and
-  dropped (end moment, 81 x 5 nodes): the total deformation gradient F, whose O(1) rotation part
-  varies along a bent beam, so that each projection's O(h^2 kappa^2) error is O(1) % of the bending
-  strain; and F recovered from the nodes' reference positions, (dX/dx)^-1 on the new cloud, which
-  is not the gradient of the discrete field. Both moved the tip by up to 0.03 L from one
-  increment count to another.
+  b is transferred across rebuilds like any state; it is I plus strain-sized terms in the current
+  frame, where the total deformation gradient F also carries the O(1) rotation, which varies along
+  a bent beam. (Transferring F instead gave the same end-moment results to within their scatter;
+  recovering F from the nodes' reference positions, (dX/dx)^-1 on the new cloud, is not the
+  gradient of the discrete field and was dropped: it moved the end-moment tip by up to 0.03 L.)
 
 Both return the first Piola-Kirchhoff stress relative to x_n, P_n = det f sigma f^-T, so the internal
 force and tangent are the total-Lagrangian operators on x_n (:mod:`ctmrpim.lagrangian_operators`).
