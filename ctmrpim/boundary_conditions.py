@@ -9,7 +9,9 @@ without any constrained node (its stiffness is singular; the sparse solver does 
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 import shapely
+from scipy.sparse.csgraph import connected_components
 
 from .assembly import dof
 from .ctm import BoundaryQuadrature, boundary_points
@@ -52,7 +54,7 @@ def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol:
                     ) -> tuple[BoundaryQuadrature, np.ndarray, np.ndarray]:
     """Gauss points on every loaded boundary segment and the traction (tx, ty) at each point."""
     x, y = nodes[:, 0], nodes[:, 1]
-    pts, wts, nrm, tx_all, ty_all, ends, follow = [], [], [], [], [], [], []
+    pts, wts, nrm, tx_all, ty_all, ends, follow, face = [], [], [], [], [], [], [], []
     loads = [("traction", i, t.where) for i, t in enumerate(problem.tractions)] + \
             [("pressure", i, p.where) for i, p in enumerate(problem.pressures)]
     for kind, i, where in loads:
@@ -64,6 +66,8 @@ def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol:
         px, py = q.points[:, 0], q.points[:, 1]
         ends.append(np.repeat(seg, TRACTION_GAUSS_POINTS, axis=0))
         follow.append(np.full(len(px), kind == "traction" and problem.tractions[i].follower))
+        face.append(np.full(len(px), kind == "traction" and problem.tractions[i].follower
+                            and problem.tractions[i].turn == "face"))
         if kind == "traction":
             t = problem.tractions[i]
             tx = _values(t.tx, px, py, f"traction[{i}].tx") if t.tx is not None else np.zeros(len(px))
@@ -74,11 +78,36 @@ def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol:
         pts.append(q.points); wts.append(q.weights); nrm.append(q.normals); tx_all.append(tx); ty_all.append(ty)
     if not pts:
         empty = BoundaryQuadrature(np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, int),
-                                   np.zeros((0, 2), int), np.zeros(0, bool))
+                                   np.zeros((0, 2), int), np.zeros(0, bool), np.zeros((0, 2), int))
         return empty, np.zeros(0), np.zeros(0)
+    ends_all, face_all = np.concatenate(ends), np.concatenate(face)
     q = BoundaryQuadrature(np.concatenate(pts), np.concatenate(wts), np.concatenate(nrm), np.zeros(0, int),
-                           np.concatenate(ends), np.concatenate(follow))
+                           ends_all, np.concatenate(follow), _turn_ends(ends_all, face_all, len(nodes)))
     return q, np.concatenate(tx_all), np.concatenate(ty_all)
+
+
+def _turn_ends(ends: np.ndarray, face: np.ndarray, n_nodes: int) -> np.ndarray:
+    """The node pair each loaded point's follower load turns with: its own segment, or for
+    ``turn = "face"`` the two end nodes of the connected stretch of face-follower boundary it lies on
+    (segments of several tractions that share a node form one face)."""
+    turn = ends.copy()
+    if not face.any():
+        return turn
+    seg = np.unique(ends[face], axis=0)
+    adj = sp.coo_matrix((np.ones(len(seg)), (seg[:, 0], seg[:, 1])), shape=(n_nodes, n_nodes))
+    _, label = connected_components(adj, directed=False)
+    degree = np.bincount(seg.ravel(), minlength=n_nodes)
+    for comp in np.unique(label[seg[:, 0]]):
+        tips = np.flatnonzero((label == comp) & (degree == 1))
+        if len(tips) != 2:
+            raise ProblemError("a follower = \"face\" traction must act on an open stretch of boundary "
+                               f"(found {len(tips)} ends instead of 2); use follower = \"segment\" on closed loops",
+                               key="traction")
+        # orient the chord like the boundary (body on the left): from the stretch's start to its end
+        start = tips[0] if np.isin(tips[0], seg[:, 0]) else tips[1]
+        mine = face & (label[ends[:, 0]] == comp)
+        turn[mine] = [start, tips[1] if start == tips[0] else tips[0]]
+    return turn
 
 
 def _values(f: Field, x: np.ndarray, y: np.ndarray, key: str) -> np.ndarray:

@@ -1,10 +1,13 @@
 """External forces of a large-deformation solve: dead and follower tractions, dead point loads.
 
 Dead tractions keep their direction and their total (nominal traction per unit reference length).
-Follower tractions turn with the boundary segment they act on, t = R(theta) t0 per unit reference
-length, with cos theta = e0 . e and sin theta = e0 x e of the reference and current unit directions
-of the segment (a pressure-like load whose total does not change as the segment stretches). Their
-load stiffness -dF_ext/dU enters the Newton tangent, which is then non-symmetric.
+Follower tractions turn, t = R(theta) t0 per unit reference length, with cos theta = e0 . e and
+sin theta = e0 x e of the reference and current unit directions of a node pair: the segment the
+point lies on (a pressure-like load), or the chord of the whole loaded face (``turn = "face"``).
+Turning each segment on its own lets a face that does not stay straight turn its tractions by
+slightly different angles, and a couple then gets a net force: on the end-moment ring (lever arm up
+to L/pi) that made the curvature 1-3.5 % too large; turning with the face keeps the couple exact.
+Their load stiffness -dF_ext/dU enters the Newton tangent, which is then non-symmetric.
 """
 from __future__ import annotations
 
@@ -23,9 +26,9 @@ class BoundaryLoads:
     weights: np.ndarray         # (m,) reference length x thickness
     tx: np.ndarray              # (m,) nominal traction per unit reference length
     ty: np.ndarray
-    ends: np.ndarray            # (m, 2) node pair of each point's boundary segment
+    turn_ends: np.ndarray       # (m, 2) node pair whose direction each point's follower load turns with
     follower: np.ndarray        # (m,) bool
-    d0: np.ndarray              # (m, 2) reference segment vectors
+    d0: np.ndarray              # (m, 2) reference vectors of those node pairs
     F_points: np.ndarray        # (2n,) dead point loads
     _dead: np.ndarray = field(init=False, repr=False)
 
@@ -37,7 +40,7 @@ class BoundaryLoads:
         (None when every load is dead)."""
         if not self.follower.any():
             return factor * self._dead, None
-        ends, tx, ty = self.ends, self.tx, self.ty
+        ends, tx, ty = self.turn_ends, self.tx, self.ty
         len0 = np.linalg.norm(self.d0, axis=1)
         e0 = self.d0 / len0[:, None]
         p0 = np.c_[-e0[:, 1], e0[:, 0]]

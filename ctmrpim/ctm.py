@@ -125,7 +125,8 @@ class BoundaryQuadrature:
     normals: np.ndarray    # (m, 2) outward unit normals
     segment: np.ndarray    # (m,) index of the boundary segment each point lies on
     ends: np.ndarray | None = None      # (m, 2) node indices of that segment, where known
-    follower: np.ndarray | None = None  # (m,) the load at the point turns with its segment
+    follower: np.ndarray | None = None  # (m,) the load at the point turns (large deformation)
+    turn_ends: np.ndarray | None = None  # (m, 2) the node pair whose direction a follower load turns with
 
 
 def boundary_points(segments: np.ndarray, gauss_points: int = 2) -> BoundaryQuadrature:

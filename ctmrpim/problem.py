@@ -28,13 +28,16 @@ class Constraint:
 @dataclass
 class Traction:
     """Surface traction (force per unit area, global x/y components) on selected boundary segments.
-    A follower traction turns with the boundary segment it acts on (large-deformation analyses); a
-    dead one keeps its direction and nominal size."""
+    A dead traction keeps its direction and nominal size. A follower traction (large-deformation
+    analyses) turns: with the boundary segment it acts on (``turn = "segment"``, pressure-like), or
+    with its whole face (``turn = "face"``: every point turns with the chord of the connected stretch
+    of face-follower boundary it lies on, so a couple stays a couple)."""
 
     where: Field
     tx: Field | None = None
     ty: Field | None = None
     follower: bool = False
+    turn: str = "segment"
 
 
 @dataclass

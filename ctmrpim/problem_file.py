@@ -196,15 +196,18 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         if "tx" not in c and "ty" not in c:
             raise ProblemError("give tx, ty or both", key=f"traction[{i}]")
         follower = c.get("follower", False)
-        if not isinstance(follower, bool):
-            raise ProblemError(f"{follower!r} must be true or false", key=f"traction[{i}].follower")
+        if follower not in (True, False, "segment", "face"):
+            raise ProblemError(f"{follower!r} must be false, true (= \"segment\") or \"face\"",
+                               key=f"traction[{i}].follower")
+        turn = follower if isinstance(follower, str) else "segment"
+        follower = follower is not False
         if follower and analysis == "linear":
             raise ProblemError("follower loads need a large-deformation analysis (quasi-static)",
                                key=f"traction[{i}].follower")
         tractions.append(Traction(where=fld(c["where"], f"traction[{i}].where"),
                                   tx=fld(c["tx"], f"traction[{i}].tx") if "tx" in c else None,
                                   ty=fld(c["ty"], f"traction[{i}].ty") if "ty" in c else None,
-                                  follower=follower))
+                                  follower=follower, turn=turn))
     pressures = [Pressure(where=fld(c["where"], f"pressure[{i}].where"), p=fld(c["p"], f"pressure[{i}].p"))
                  for i, c in enumerate(raw.get("pressure", []))]
     probes = []

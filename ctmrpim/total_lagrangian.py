@@ -59,8 +59,8 @@ def solve_total_lagrangian(case: Case) -> Result:
     w = quad.weights * problem.thickness
     wt = traction_q.weights * problem.thickness
     follower = traction_q.follower
-    loads = BoundaryLoads(sf_t.N, wt, tx, ty, traction_q.ends, follower,
-                          nodes[traction_q.ends[:, 1]] - nodes[traction_q.ends[:, 0]],
+    turn = traction_q.turn_ends
+    loads = BoundaryLoads(sf_t.N, wt, tx, ty, turn, follower, nodes[turn[:, 1]] - nodes[turn[:, 0]],
                           problem.thickness * assembly.point_load_vector(nodes, problem, rpim))
 
     timer.lap("assembly")

@@ -79,7 +79,8 @@ def stress_update(case: Case):
 
 @dataclass
 class TractionTags:
-    """Loaded boundary Gauss points as tags: segment node pair, fraction along it, nominal load."""
+    """Loaded boundary Gauss points as tags: segment node pair, fraction along it, nominal load, and
+    the node pair (reference vector d0) a follower load turns with."""
 
     ends: np.ndarray
     fraction: np.ndarray
@@ -87,6 +88,7 @@ class TractionTags:
     tx: np.ndarray
     ty: np.ndarray
     follower: np.ndarray
+    turn_ends: np.ndarray
     d0: np.ndarray
 
     def positions(self, x: np.ndarray) -> np.ndarray:
@@ -192,7 +194,7 @@ class AdaptiveBody:
         self.points, self.w, self.points_X = points, w, ref
         self.G = gradient_operator(sf.dNdx, sf.dNdy)
         self.GT = self.G.T
-        self.loads = BoundaryLoads(Nt, tr.weights, tr.tx, tr.ty, tr.ends, tr.follower, tr.d0, F_points)
+        self.loads = BoundaryLoads(Nt, tr.weights, tr.tx, tr.ty, tr.turn_ends, tr.follower, tr.d0, F_points)
         self.timer.lap("shape_functions")
 
     # -- increments ----------------------------------------------------------------------------------
@@ -293,9 +295,10 @@ def _traction_tags(conf, thickness: float) -> TractionTags:
     q = conf.traction
     nodes = conf.disc.nodes
     a, b = nodes[q.ends[:, 0]], nodes[q.ends[:, 1]]
-    d0 = b - a
-    fraction = np.einsum("pd,pd->p", q.points - a, d0) / np.einsum("pd,pd->p", d0, d0)
-    return TractionTags(q.ends, fraction, q.weights * thickness, conf.tx, conf.ty, q.follower, d0)
+    fraction = np.einsum("pd,pd->p", q.points - a, b - a) / np.einsum("pd,pd->p", b - a, b - a)
+    turn = q.turn_ends
+    return TractionTags(q.ends, fraction, q.weights * thickness, conf.tx, conf.ty, q.follower, turn,
+                        nodes[turn[:, 1]] - nodes[turn[:, 0]])
 
 
 def adaptive_body(case: Case, timer: Timer | None = None) -> tuple[AdaptiveBody, Configuration]:

@@ -19,7 +19,7 @@ import time
 import numpy as np
 from scipy.sparse import csc_matrix
 from scipy.sparse.linalg import splu
-from skfem import Basis, BilinearForm, ElementVector, LinearForm, condense, solve
+from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, condense, solve
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.hyperelastic import NeoHookean
@@ -28,7 +28,7 @@ from ctmrpim.problem_file import Case
 from ctmrpim.result import Result, probe_record
 
 from .mesh import FemMesh, build_mesh
-from .solve import SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate
+from .solve import FACET_ORDER, SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate, _selected_facets, _value
 
 #: Quadrature degree of f_int and K (P, A are not polynomial: one order above the linear need for P2).
 TANGENT_ORDER = {"q1": 2, "p1": 1, "p2": 4}
@@ -44,6 +44,56 @@ def _tangent_form(u, v, w):
 @LinearForm
 def _internal_form(v, w):
     return np.einsum("iJ...,iJ...->...", w.P, v.grad)
+
+
+def _follower_traction(w, dd=None):
+    """Follower traction R(theta) t0 at facet points (per unit reference length), or with ``dd`` (the
+    change of the current tangent d = F e0) its derivative. e0 is the reference tangent with the body
+    on its left, p0 = -n its normal towards the body; cos theta = e0 . e, sin theta = p0 . e."""
+    n = w.n
+    e0 = np.stack([-n[1], n[0]])
+    p0 = -n
+    G = w.u.grad
+    d = e0 + np.einsum("iJ...,J...->i...", G, e0)
+    length = np.sqrt(d[0] ** 2 + d[1] ** 2)
+    e = d / length
+    tx, ty = w.tx, w.ty
+    if dd is None:
+        c, s = (e0 * e).sum(0), (p0 * e).sum(0)
+    else:   # d(c, s) = (e0, p0) . (I - e e^T) dd / |d|
+        dperp = (dd - e * (e * dd).sum(0)) / length
+        c, s = (e0 * dperp).sum(0), (p0 * dperp).sum(0)
+    return c * tx - s * ty, s * tx + c * ty
+
+
+@LinearForm
+def _follower_form(v, w):
+    rx, ry = _follower_traction(w)
+    return rx * v[0] + ry * v[1]
+
+
+@BilinearForm
+def _follower_stiffness_form(u, v, w):
+    """-d(F_ext)/du of the follower traction (the load stiffness; not symmetric)."""
+    n = w.n
+    e0 = np.stack([-n[1], n[0]])
+    drx, dry = _follower_traction(w, dd=np.einsum("iJ...,J...->i...", u.grad, e0))
+    return -(drx * v[0] + dry * v[1])
+
+
+def _follower_loads(problem, fm: FemMesh, vec, tol: float) -> list[tuple[FacetBasis, np.ndarray, np.ndarray]]:
+    """Facet bases and nominal tractions of the follower tractions."""
+    out = []
+    for i, tr in enumerate(problem.tractions):
+        if not tr.follower:
+            continue
+        _, facets = _selected_facets(tr.where, fm, tol)
+        if len(facets) == 0:
+            raise ProblemError(f"where = {tr.where.text!r} selects no boundary segment", key=f"traction[{i}]")
+        fb = FacetBasis(fm.mesh, vec, facets=facets, intorder=FACET_ORDER)
+        xq = np.asarray(fb.global_coordinates())
+        out.append((fb, _value(tr.tx, xq[0], xq[1]), _value(tr.ty, xq[0], xq[1])))
+    return out
 
 
 def _deformation_gradients(basis: Basis, U: np.ndarray) -> np.ndarray:
@@ -85,9 +135,6 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
         raise ProblemError(f"element {element!r} is not supported (supported: {', '.join(SCALAR_ELEMENTS)})")
     if not (isinstance(refine, int) and refine >= 0):
         raise ProblemError(f"refine = {refine!r} must be an integer >= 0")
-    for i, tr in enumerate(problem.tractions):
-        if tr.follower:
-            raise ProblemError("follower loads are not supported by the FEM reference", key=f"traction[{i}].follower")
     if problem.point_loads:
         raise ProblemError("point loads are not supported by the FEM reference (yet)", key="point_load")
 
@@ -119,10 +166,17 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
 
     series: list[dict] = []
 
+    followers = _follower_loads(problem, fm, vec, tol)
+
     def assemble(U: np.ndarray, factor: float):
         P, A = _stress_tangent(material, basis, U)      # an inverted material cuts the increment back
-        return (factor * F_dead, thickness * _internal_form.assemble(basis, P=P),
-                thickness * _tangent_form.assemble(basis, A=A))
+        f_ext = factor * F_dead
+        K = thickness * _tangent_form.assemble(basis, A=A)
+        for fb, tx, ty in followers:
+            kw = dict(u=fb.interpolate(U), tx=factor * tx, ty=factor * ty)
+            f_ext = f_ext + thickness * _follower_form.assemble(fb, **kw)
+            K = K + thickness * _follower_stiffness_form.assemble(fb, **kw)
+        return f_ext, thickness * _internal_form.assemble(basis, P=P), K
 
     def solve_increment(K, residual):
         return solve(*condense(K, residual, D=fixed))

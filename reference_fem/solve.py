@@ -128,10 +128,13 @@ def _selected_facets(where: Field, fm: FemMesh, tol: float) -> tuple[np.ndarray,
 
 
 def _load_vector(problem: Problem, fm: FemMesh, vec, tol: float, ndofs: int) -> np.ndarray:
-    """Tractions and pressures, integrated over the boundary facets they select."""
+    """Dead tractions and pressures, integrated over the boundary facets they select (follower
+    tractions are the large-deformation solver's: :mod:`reference_fem.hyperelastic`)."""
     F = np.zeros(ndofs)
     loads: list[tuple[str, Field, Callable[[np.ndarray, np.ndarray, np.ndarray], tuple]]] = []
     for i, tr in enumerate(problem.tractions):
+        if tr.follower:
+            continue
         loads.append((f"traction[{i}]", tr.where,
                       lambda x, y, n, tr=tr: (_value(tr.tx, x, y), _value(tr.ty, x, y))))
     for i, pr in enumerate(problem.pressures):
