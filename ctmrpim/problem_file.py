@@ -196,7 +196,7 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         if "tx" not in c and "ty" not in c:
             raise ProblemError("give tx, ty or both", key=f"traction[{i}]")
         follower = c.get("follower", False)
-        if follower not in (True, False, "segment", "face"):
+        if not (isinstance(follower, bool) or follower in ("segment", "face")):   # 1 == True: test the type
             raise ProblemError(f"{follower!r} must be false, true (= \"segment\") or \"face\"",
                                key=f"traction[{i}].follower")
         turn = follower if isinstance(follower, str) else "segment"

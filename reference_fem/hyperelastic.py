@@ -17,7 +17,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy.sparse import csc_matrix
+from scipy.sparse import coo_matrix, csc_matrix
 from scipy.sparse.linalg import splu
 from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, condense, solve
 
@@ -82,10 +82,10 @@ def _follower_stiffness_form(u, v, w):
 
 
 def _follower_loads(problem, fm: FemMesh, vec, tol: float) -> list[tuple[FacetBasis, np.ndarray, np.ndarray]]:
-    """Facet bases and nominal tractions of the follower tractions."""
+    """Facet bases and nominal tractions of the follower tractions that turn with their segment."""
     out = []
     for i, tr in enumerate(problem.tractions):
-        if not tr.follower:
+        if not tr.follower or tr.turn != "segment":
             continue
         _, facets = _selected_facets(tr.where, fm, tol)
         if len(facets) == 0:
@@ -94,6 +94,65 @@ def _follower_loads(problem, fm: FemMesh, vec, tol: float) -> list[tuple[FacetBa
         xq = np.asarray(fb.global_coordinates())
         out.append((fb, _value(tr.tx, xq[0], xq[1]), _value(tr.ty, xq[0], xq[1])))
     return out
+
+
+@LinearForm
+def _rotated_traction_form(v, w):
+    return -w.ty * v[0] + w.tx * v[1]          # t0 turned by 90 degrees
+
+
+class FaceFollower:
+    """Follower tractions that turn with the chord of their connected face (``turn = "face"``).
+
+    All tractions on one face turn by the same angle, so F_ext = c F0 + s F90 with F0 the dead
+    vector of t0, F90 that of t0 turned by 90 degrees, and (c, s) = (e0 . e, p0 . e) of the chord
+    between the face's two end vertices; the load stiffness is the rank-2 term
+    -(F0 dc/dU + F90 ds/dU), non-zero in the four dofs of those vertices only."""
+
+    def __init__(self, problem, fm: FemMesh, vec, basis, tol: float):
+        self.faces: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        facets_all, F0, F90 = [], np.zeros(basis.N), np.zeros(basis.N)
+        for i, tr in enumerate(problem.tractions):
+            if not (tr.follower and tr.turn == "face"):
+                continue
+            _, facets = _selected_facets(tr.where, fm, tol)
+            if len(facets) == 0:
+                raise ProblemError(f"where = {tr.where.text!r} selects no boundary segment", key=f"traction[{i}]")
+            fb = FacetBasis(fm.mesh, vec, facets=facets, intorder=FACET_ORDER)
+            xq = np.asarray(fb.global_coordinates())
+            tx, ty = _value(tr.tx, xq[0], xq[1]), _value(tr.ty, xq[0], xq[1])
+            F0 += problem.thickness * LinearForm(lambda v, w: w.tx * v[0] + w.ty * v[1]).assemble(fb, tx=tx, ty=ty)
+            F90 += problem.thickness * _rotated_traction_form.assemble(fb, tx=tx, ty=ty)
+            facets_all.append(facets)
+        if not facets_all:
+            return
+        ends = fm.mesh.facets[:, np.unique(np.concatenate(facets_all))]
+        degree = np.bincount(ends.ravel(), minlength=fm.mesh.nvertices)
+        tips = np.flatnonzero(degree == 1)
+        if len(tips) != 2:
+            raise ProblemError("follower = \"face\" tractions must load one open stretch of boundary in the FEM "
+                               f"reference (found {len(tips)} ends)", key="traction")
+        a, b = tips
+        self.faces.append((basis.nodal_dofs[:, a], basis.nodal_dofs[:, b], fm.mesh.p[:, b] - fm.mesh.p[:, a], F0, F90))
+
+    def forces(self, U: np.ndarray, factor: float) -> tuple[np.ndarray | float, coo_matrix | None]:
+        """F_ext of the face followers at load factor ``factor`` and its stiffness -dF_ext/dU."""
+        F, K = 0.0, None
+        for da, db, d0, F0, F90 in self.faces:
+            d = d0 + U[db] - U[da]
+            length = np.linalg.norm(d)
+            e0 = d0 / np.linalg.norm(d0)
+            p0 = np.array([-e0[1], e0[0]])
+            e = d / length
+            proj = (np.eye(2) - np.outer(e, e)) / length
+            dc, ds = e0 @ proj, p0 @ proj                    # derivatives w.r.t. d
+            F = F + factor * ((e0 @ e) * F0 + (p0 @ e) * F90)
+            cols = np.concatenate([db, da])
+            rows = np.flatnonzero((F0 != 0) | (F90 != 0))
+            block = -factor * (np.outer(F0[rows], np.r_[dc, -dc]) + np.outer(F90[rows], np.r_[ds, -ds]))
+            Kf = coo_matrix((block.ravel(), (np.repeat(rows, 4), np.tile(cols, len(rows)))), shape=(len(U), len(U)))
+            K = Kf if K is None else K + Kf
+        return F, K
 
 
 def _deformation_gradients(basis: Basis, U: np.ndarray) -> np.ndarray:
@@ -167,6 +226,7 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
     series: list[dict] = []
 
     followers = _follower_loads(problem, fm, vec, tol)
+    faces = FaceFollower(problem, fm, vec, basis, tol)
 
     def assemble(U: np.ndarray, factor: float):
         P, A = _stress_tangent(material, basis, U)      # an inverted material cuts the increment back
@@ -176,6 +236,9 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
             kw = dict(u=fb.interpolate(U), tx=factor * tx, ty=factor * ty)
             f_ext = f_ext + thickness * _follower_form.assemble(fb, **kw)
             K = K + thickness * _follower_stiffness_form.assemble(fb, **kw)
+        F_face, K_face = faces.forces(U, factor)
+        if K_face is not None:
+            f_ext, K = f_ext + F_face, K + K_face
         return f_ext, thickness * _internal_form.assemble(basis, P=P), K
 
     def solve_increment(K, residual):

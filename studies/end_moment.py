@@ -3,7 +3,9 @@ the exact circular arc x = L sin(t)/t, y = L (1 - cos t)/t, t = 2 pi m, for frac
 moment 2 pi E I / L; 81 x 5 = 405 nodes, neo-Hookean CTM-RPIM: adaptive updated-Lagrangian (UL, 64
 increments per ring, boundary re-tracked, CTM points laid anew and RPIM rebuilt after each, as in the
 paper), the same with the integration points carried by the body (UL carried: boundary and RPIM
-rebuilt, points and their state kept) and total-Lagrangian (TL, 32 increments per ring).
+rebuilt, points and their state kept), total-Lagrangian (TL, 32 increments per ring), and scikit-fem
+P2 (total-Lagrangian, same nodes). The two end tractions turn with the end face as a whole
+(`follower = "face"`), so the moment stays a pure couple.
 At m = 1 the exact beam closes into a circle of radius L / (2 pi).
 """
 from __future__ import annotations
@@ -32,10 +34,14 @@ FORMULATIONS = {"UL": ('method.formulation="updated-lagrangian"',),
 
 
 def specs(quick: bool) -> list[CaseSpec]:
-    return [CaseSpec("end-moment", (f"parameters.m={m!r}", f"loading.steps={int(np.ceil(STEPS_PER_RING[short] * m))}",
+    ms = QUICK if quick else FULL
+    ours = [CaseSpec("end-moment", (f"parameters.m={m!r}", f"loading.steps={int(np.ceil(STEPS_PER_RING[short] * m))}",
                                     *overrides),
                      labels=(("formulation", short), ("m", m)))
-            for short, overrides in FORMULATIONS.items() for m in (QUICK if quick else FULL)]
+            for short, overrides in FORMULATIONS.items() for m in ms]
+    fem = [CaseSpec("end-moment", (f"parameters.m={m!r}", f"loading.steps={int(np.ceil(STEPS_PER_RING['TL'] * m))}"),
+                    "fem", "p2", labels=(("formulation", "TL"), ("m", m))) for m in ms]
+    return ours + fem
 
 
 def extra(summary: dict) -> dict:
@@ -55,10 +61,12 @@ def figure(df: pd.DataFrame):
     ax.plot(path[:, 0], path[:, 1], "k-", label="exact tip path")
     ok = df[df.status == "ok"]
     for formulation, marker in (("UL", "o"), ("UL carried", "D"), ("TL", "s")):
-        d = ok[ok.formulation == formulation]
+        d = ok[(ok.formulation == formulation) & (ok.method == "ctm-rpim")]
         ax.plot(d.x_over_L, d.y_over_L, marker, mfc="none" if formulation != "UL" else None,
                 label=f"CTM-RPIM ({formulation})")
-    for _, r in ok[ok.formulation == "UL"].iterrows():
+    d = ok[ok.method == "fem-p2"]
+    ax.plot(d.x_over_L, d.y_over_L, "k+", ms=9, label="scikit-fem P2 (TL)")
+    for _, r in ok[(ok.formulation == "UL") & (ok.method == "ctm-rpim")].iterrows():
         ax.annotate(f"m = {r.m:g}", (r.x_over_L, r.y_over_L), textcoords="offset points", xytext=(6, 4), fontsize=8)
     ax.set(xlabel="x / L", ylabel="y / L", title=TITLE, aspect="equal")
     return finished(fig, axes)

@@ -1,4 +1,4 @@
-"""Cantilever under a follower end moment (paper Figs. 16-17): total-Lagrangian CTM-RPIM against the
+"""Cantilever under a follower end moment (paper Figs. 16-17): total-Lagrangian CTM-RPIM and scikit-fem against the
 exact circular arc; follower loads and their stiffness."""
 from __future__ import annotations
 
@@ -24,3 +24,56 @@ def test_quarter_ring_moment_against_the_exact_arc() -> None:
 def test_follower_loads_need_a_large_deformation_analysis() -> None:
     with pytest.raises(ProblemError, match="follower loads need"):
         benchmarks.load("end-moment", ['problem.analysis="linear"', 'material.model="linear-elastic"'])
+
+
+def test_face_follower_tractions_stay_a_couple() -> None:
+    """follower = "face": both half-face tractions turn with the chord of the whole end face, so at
+    any displacement their nodal forces sum to zero (a pure couple) and turn rigidly."""
+    from ctmrpim.boundary_loads import BoundaryLoads
+    from ctmrpim.linear_static import Timer, build_configuration
+
+    case = benchmarks.load("end-moment", ["parameters.m=0.25"])
+    conf = build_configuration(case, Timer())
+    X, q = conf.disc.nodes, conf.traction
+    corners = {int(np.argmin(np.hypot(X[:, 0] - L, X[:, 1] - y))) for y in (-0.25, 0.25)}
+    assert {frozenset(map(int, pair)) for pair in q.turn_ends} == {frozenset(corners)}
+    turn = q.turn_ends
+    loads = BoundaryLoads(conf.sf_traction.N, q.weights, conf.tx, conf.ty, turn, q.follower,
+                          X[turn[:, 1]] - X[turn[:, 0]], np.zeros(X.size))
+    F0, _ = loads.forces(X, 1.0)
+    rng = np.random.default_rng(0)
+    theta = 1.1
+    R = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+    x = (X @ R.T) + 0.01 * rng.standard_normal(X.shape) * (X[:, :1] < L - 1.0)   # rotate, perturb the inside
+    F, K = loads.forces(x, 1.0)
+    scale = np.abs(F).max()
+    assert np.abs(F.reshape(-1, 2).sum(axis=0)).max() <= 1e-12 * scale        # no net force
+    assert np.abs(F.reshape(-1, 2) - F0.reshape(-1, 2) @ R.T).max() <= 1e-9 * scale   # turned rigidly
+    assert K is not None
+
+
+def test_fem_p2_end_moment_with_face_followers() -> None:
+    """The scikit-fem reference applies the same face-turning couple (rank-2 load stiffness)."""
+    from reference_fem.hyperelastic import solve_fem_hyperelastic
+
+    r = solve_fem_hyperelastic(benchmarks.load("end-moment", ["parameters.m=0.25", "loading.steps=8"]), "p2")
+    x, y = 1.0 + r.probes["tip"]["ux"] / L, r.probes["tip"]["uy"] / L
+    ex, ey = elastica.end_moment_tip(2 * np.pi * 0.25)
+    check("end-moment-fem-p2-quarter", float(np.hypot(x - ex, y - ey)))
+    assert r.counts["cutbacks"] == 0
+
+
+@pytest.mark.parametrize("value, ok", [(True, True), ("segment", True), ("face", True), ("diagonal", False), (1, False)])
+def test_follower_values(value, ok: bool) -> None:
+    import tomllib
+
+    from ctmrpim.problem_file import parse_case
+
+    raw = tomllib.loads(benchmarks.path("end-moment").read_text())
+    raw["traction"][0]["follower"] = value
+    if ok:
+        case = parse_case(raw, "end-moment", benchmarks.FOLDER, [])
+        assert case.problem.tractions[0].turn == ("face" if value == "face" else "segment")
+    else:
+        with pytest.raises(ProblemError, match="must be false, true"):
+            parse_case(raw, "end-moment", benchmarks.FOLDER, [])
