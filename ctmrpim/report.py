@@ -200,9 +200,12 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
       "by 1e-5 relative) gives +0.6-1.0 % in w/L. The total-Lagrangian CTM-RPIM gives +1.1-1.2 % at every load, "
       "so its own discretisation error is about +0.2-0.5 % at 306 nodes. The adaptive updated-Lagrangian path "
       "(the paper's method) gives -1.7 % (lambda 0.12), +0.2 % (0.6) .. +0.9 % (3.6) in the full run: within "
-      "the 2 % of the issue at every load, but its error is not smooth in the load, and moves by up to about "
-      "1 % with the number of increments, because every increment is solved on the configuration the last one "
-      "left (new CTM points and shape functions on a bent beam). With the paper's corner load the tip deflects "
+      "the 2 % of the issue at every load, but its error is not smooth in the load and moves by up to about "
+      "1 % with the number of increments: every increment is solved on new CTM points laid over the bent "
+      "beam, and at small loads the horizontal CTM lines cross the slightly inclined beam at grazing angles, "
+      "where one-point integration is worst (a straight beam turned by 5 degrees: +1.8 % against +0.8 % "
+      "aligned). With the points carried by the body (`method.point_regeneration = 0.5`) the UL run gives "
+      "+1.11 .. +1.17 % at all seven loads, like TL. With the paper's corner load the tip deflects "
       "2-4 % more, and the elastica with the matching end moment predicts exactly that.\n\n")
     w("## Large deflection: end moment (cf. Figs. 16-17)\n\n")
     w(f"{studies.study('end_moment').__doc__.strip()}\n\n")
@@ -226,8 +229,10 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
       "0.1 %, and the ring's lever arm (up to L / pi) turns that into 1-3.5 % too much curvature - for "
       "scikit-fem P2 as much as for CTM-RPIM (P2, twice refined: 1.3 % at m = 0.5). The benchmark therefore "
       "turns both tractions with the end face as a whole (`follower = \"face\"`). With per-segment turning "
-      "the adaptive UL run also scattered by +-2 % from increment to increment, because every rebuild "
-      "changed the face's discrete shape; with the face turning as a whole it falls to about +-0.5 %.\n\n")
+      "the adaptive UL run also scattered by +-2 % in curvature from one increment to the next; with the face "
+      "turning as a whole that falls to about +-0.5 %, so most of it came from the load, not from the "
+      "rebuilds. What is left is the rebuilds' own: with the points carried (`method.point_regeneration`) the "
+      "curve is smooth.\n\n")
     from studies import deformed_shapes
     deformed_shapes.run(quick, out_dir, progress)
     w(f"### Deformed configurations (cf. Figs. 15 and 17)\n\n{deformed_shapes.__doc__.strip()}\n\n"
