@@ -1,0 +1,194 @@
+"""Mohr-Coulomb elastic-perfectly plastic material, plane strain, non-associated (issue 5; DESIGN.md).
+
+Yield and plastic potential in principal stresses s1 >= s2 >= s3 (tension positive), sigma_zz carried
+as one of the three and sorted with the in-plane two every time:
+
+    f = (s1 - s3) + (s1 + s3) sin(phi) - 2 c cos(phi),     g = (s1 - s3) + (s1 + s3) sin(psi).
+
+The return mapping is de Souza Neto, Peric & Owen (2008), Box 8.4, for perfect plasticity, where
+every return is closed form: the main plane, the right edge (s1 = s2), the left edge (s2 = s3) and the
+apex. Each is tried in that order and accepted when its multipliers are non-negative and the
+returned stresses keep their order. The apex, s_i = c cot(phi), exists only for phi > 0; no cot(phi)
+or 1/sin(phi) appears elsewhere, so phi -> 0 (the undrained footing) stays finite.
+
+The consistent tangent d sigma_{n+1} / d(strain increment) is the exact derivative of this return
+map within its region, by complex steps (three in-plane strain components): every branch decision is
+made on the real part, and the 2 x 2 eigen-decomposition is written in closed form.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ProblemError
+
+#: Complex-step size for the tangent.
+COMPLEX_STEP = 1e-30
+#: Relative yield tolerance: a trial state with f <= this x (c + |p|) is elastic.
+YIELD_TOL = 1e-10
+#: In-plane principal stresses closer than this (relative) are separated by a tiny shear, so that the
+#: closed-form eigenvectors (and their complex-step derivatives) stay defined.
+EIGEN_GAP = 1e-12
+
+ELASTIC, MAIN, RIGHT, LEFT, APEX = 0, 1, 2, 3, 4
+
+
+@dataclass(frozen=True)
+class MohrCoulomb:
+    E: float
+    nu: float
+    c: float
+    phi: float          # degrees
+    psi: float = 0.0    # degrees
+    density: float = 0.0
+
+    def __post_init__(self) -> None:
+        for key, ok in (("E", self.E > 0), ("nu", -1.0 < self.nu < 0.5), ("c", self.c >= 0),
+                        ("phi", 0.0 <= self.phi < 90.0), ("psi", 0.0 <= self.psi <= self.phi),
+                        ("density", self.density >= 0)):
+            if not ok:
+                raise ProblemError(f"{getattr(self, key)!r} is out of range", key=f"material.{key}")
+        if self.c == 0 and self.phi == 0:
+            raise ProblemError("c = 0 and phi = 0: the material has no strength", key="material.c")
+
+    @property
+    def G(self) -> float:
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def K(self) -> float:
+        return self.E / (3.0 * (1.0 - 2.0 * self.nu))
+
+    def D(self, plane: str = "strain") -> np.ndarray:
+        from .material import LinearElastic
+        return LinearElastic(self.E, self.nu, self.density).D(plane)
+
+    def yield_function(self, stress: np.ndarray) -> np.ndarray:
+        """f at stresses (m, 4) = sxx, syy, sxy, szz."""
+        s, _ = _principal(stress)
+        sp = np.sin(np.radians(self.phi))
+        return (s[:, 0] - s[:, 2]) + (s[:, 0] + s[:, 2]) * sp - 2.0 * self.c * np.cos(np.radians(self.phi))
+
+    def update(self, stress: np.ndarray, dstrain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Stress (m, 4) after the strain increment ``dstrain`` (m, 3: exx, eyy, gxy; ezz = 0) from
+        ``stress`` (m, 4), and the return region of each point (ELASTIC, MAIN, RIGHT, LEFT, APEX)."""
+        return self._update(stress, dstrain)
+
+    def tangent(self, stress: np.ndarray, dstrain: np.ndarray) -> np.ndarray:
+        """(m, 3, 3) consistent tangent d(sxx, syy, sxy)_{n+1} / d(exx, eyy, gxy)."""
+        m = len(stress)
+        out = np.empty((m, 3, 3))
+        dc = dstrain.astype(complex)
+        for k in range(3):
+            dc[:, k] += 1j * COMPLEX_STEP
+            s, _ = self._update(stress, dc)
+            out[:, :, k] = s[:, :3].imag / COMPLEX_STEP
+            dc[:, k] = dstrain[:, k]
+        return out
+
+    # ----------------------------------------------------------------------------------------------
+    def _update(self, stress: np.ndarray, dstrain: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        G, K = self.G, self.K
+        lam = K - 2.0 * G / 3.0
+        e = dstrain
+        tr = e[:, 0] + e[:, 1]
+        trial = np.stack([stress[:, 0] + lam * tr + 2.0 * G * e[:, 0],
+                          stress[:, 1] + lam * tr + 2.0 * G * e[:, 1],
+                          stress[:, 2] + G * e[:, 2],
+                          stress[:, 3] + lam * tr], axis=1)
+        out = trial.copy()
+        region = np.zeros(len(stress), dtype=np.int8)
+        s, vec = _principal(trial)
+        sphi, cphi = np.sin(np.radians(self.phi)), np.cos(np.radians(self.phi))
+        spsi = np.sin(np.radians(self.psi))
+        f = (s[:, 0] - s[:, 2]) + (s[:, 0] + s[:, 2]) * sphi - 2.0 * self.c * cphi
+        scale = self.c + np.abs(s.real).max(axis=1)
+        plastic = f.real > YIELD_TOL * scale
+        if not plastic.any():
+            return out, region
+        s, vec, f = s[plastic], tuple(v[plastic] for v in vec), f[plastic]
+        ret = np.empty_like(s)
+        reg = np.zeros(len(s), dtype=np.int8)
+        # main plane
+        a = 4.0 * G * (1.0 + sphi * spsi / 3.0) + 4.0 * K * sphi * spsi
+        r1 = 2.0 * G * (1.0 + spsi / 3.0) + 2.0 * K * spsi          # dg/ds1 stiffness terms
+        r2 = (4.0 * G / 3.0 - 2.0 * K) * spsi
+        r3 = 2.0 * G * (1.0 - spsi / 3.0) - 2.0 * K * spsi
+        dg = f / a
+        main = np.stack([s[:, 0] - r1 * dg, s[:, 1] + r2 * dg, s[:, 2] + r3 * dg], axis=1)
+        ok = (main[:, 0].real >= main[:, 1].real) & (main[:, 1].real >= main[:, 2].real)
+        ret[ok], reg[ok] = main[ok], MAIN
+        todo = ~ok
+        if todo.any():
+            right = todo & (main[:, 1].real > main[:, 0].real)      # s2 passed s1: the edge s1 = s2
+            left = todo & ~right                                    # s3 passed s2: the edge s2 = s3
+            fa = f
+            if right.any():
+                fb = (s[:, 1] - s[:, 2]) + (s[:, 1] + s[:, 2]) * sphi - 2.0 * self.c * cphi
+                b = 2.0 * G * (1.0 - sphi - spsi - sphi * spsi / 3.0) + 4.0 * K * sphi * spsi
+                det = a * a - b * b
+                ga, gb = (a * fa - b * fb) / det, (a * fb - b * fa) / det
+                edge = np.stack([s[:, 0] - r1 * ga + r2 * gb, s[:, 1] + r2 * ga - r1 * gb,
+                                 s[:, 2] + r3 * (ga + gb)], axis=1)
+                good = right & (ga.real >= 0) & (gb.real >= 0) & (edge[:, 1].real >= edge[:, 2].real)
+                ret[good], reg[good] = edge[good], RIGHT
+                todo &= ~good
+            if left.any():
+                fb = (s[:, 0] - s[:, 1]) + (s[:, 0] + s[:, 1]) * sphi - 2.0 * self.c * cphi
+                b = 2.0 * G * (1.0 + sphi + spsi - sphi * spsi / 3.0) + 4.0 * K * sphi * spsi
+                det = a * a - b * b
+                ga, gb = (a * fa - b * fb) / det, (a * fb - b * fa) / det
+                edge = np.stack([s[:, 0] - r1 * (ga + gb), s[:, 1] + r2 * ga + r3 * gb,
+                                 s[:, 2] + r3 * ga + r2 * gb], axis=1)
+                good = left & (ga.real >= 0) & (gb.real >= 0) & (edge[:, 0].real >= edge[:, 1].real)
+                ret[good], reg[good] = edge[good], LEFT
+                todo &= ~good
+            if todo.any():
+                if sphi <= 0.0:
+                    raise ProblemError("Mohr-Coulomb return: a stress state beyond both edges with phi = 0 "
+                                       "(no apex); the strain increment is too large")
+                apex = self.c * cphi / sphi
+                ret[todo], reg[todo] = apex, APEX
+        sigma = _assemble(ret, vec)
+        out[plastic] = sigma
+        region[plastic] = reg
+        return out, region
+
+
+def _principal(stress: np.ndarray):
+    """Principal stresses (m, 3) sorted s1 >= s2 >= s3 (by real part) and what rebuilds the tensor:
+    the in-plane unit eigenvector of the larger in-plane value and which sorted slot holds szz."""
+    sxx, syy, sxy, szz = stress[:, 0], stress[:, 1], stress[:, 2], stress[:, 3]
+    centre = 0.5 * (sxx + syy)
+    half = 0.5 * (sxx - syy)
+    gap = np.abs(half.real) + np.abs(sxy.real)
+    tiny = EIGEN_GAP * (np.abs(centre.real) + gap + 1e-300)
+    sxy = np.where(gap < tiny, sxy + tiny, sxy)
+    radius = np.sqrt(half * half + sxy * sxy)
+    big, small = centre + radius, centre - radius
+    # eigenvector of `big`: (cos t, sin t) with tan 2t = 2 sxy / (sxx - syy)
+    nx, ny = radius + half, sxy
+    norm = np.sqrt(nx * nx + ny * ny)
+    flip = np.abs(norm.real) < 1e-300                       # sxx < syy with sxy ~ 0: the y axis
+    nx = np.where(flip, 0.0, nx / np.where(flip, 1.0, norm))
+    ny = np.where(flip, 1.0, ny / np.where(flip, 1.0, norm))
+    # slot of szz among the three sorted values
+    zslot = np.where(szz.real >= big.real, 0, np.where(szz.real >= small.real, 1, 2))
+    s = np.empty((len(stress), 3), dtype=np.result_type(stress.dtype, big.dtype))
+    s[:, 0] = np.where(zslot == 0, szz, big)
+    s[:, 1] = np.where(zslot == 0, big, np.where(zslot == 1, szz, small))
+    s[:, 2] = np.where(zslot == 2, szz, small)
+    return s, (nx, ny, zslot)
+
+
+def _assemble(s: np.ndarray, vec) -> np.ndarray:
+    """Stress (m, 4) from sorted principal values and the eigen-structure of :func:`_principal`."""
+    nx, ny, zslot = vec
+    szz = s[np.arange(len(s)), zslot]
+    big = np.where(zslot == 0, s[:, 1], s[:, 0])
+    small = np.where(zslot == 2, s[:, 1], s[:, 2])
+    sxx = big * nx * nx + small * ny * ny
+    syy = big * ny * ny + small * nx * nx
+    sxy = (big - small) * nx * ny
+    return np.stack([sxx, syy, sxy, szz], axis=1)
