@@ -22,6 +22,7 @@ from .expressions import Field, constant
 from .geometry import CIRCLE_SAGITTA, Geometry, Shape
 from .hyperelastic import NeoHookean
 from .material import LinearElastic
+from .mohr_coulomb import MohrCoulomb
 from .method import Method
 from .nodes import NodeSpec
 from .problem import Constraint, ExactSolution, PointLoad, Pressure, Probe, Problem, Traction
@@ -31,7 +32,7 @@ SECTIONS: dict[str, set[str] | None] = {
     "parameters": None,  # any names
     "geometry": {"add", "subtract"},
     "nodes": {"grid", "spacing", "file"},
-    "material": {"model", "E", "nu", "density"},
+    "material": {"model", "E", "nu", "density", "c", "phi", "psi"},
     "method": set(Method.__dataclass_fields__),
     "constraint": {"where", "ux", "uy"},
     "traction": {"where", "tx", "ty", "follower"},
@@ -49,9 +50,9 @@ REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E",
 SYNONYMS = {"youngs": "E", "young": "E", "youngs_modulus": "E", "young_modulus": "E", "modulus": "E",
             "poisson": "nu", "poissons_ratio": "nu", "poisson_ratio": "nu", "rho": "density"}
 ANALYSES = ("linear", "quasi-static")
-MATERIAL_MODELS = ("linear-elastic", "neo-hookean")
+MATERIAL_MODELS = ("linear-elastic", "neo-hookean", "mohr-coulomb")
 #: the material models each analysis solves (quasi-static linear-elastic: the updated-Lagrangian rate form)
-ANALYSIS_MODELS = {"linear": ("linear-elastic",), "quasi-static": ("neo-hookean", "linear-elastic")}
+ANALYSIS_MODELS = {"linear": ("linear-elastic",), "quasi-static": ("neo-hookean", "linear-elastic", "mohr-coulomb")}
 
 
 @dataclass(frozen=True)
@@ -181,6 +182,15 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
                              density=num(get("material", "density", 0.0), "material.density"))
     if mat["model"] == "neo-hookean":
         material = NeoHookean(material.E, material.nu, material.density)
+    elif mat["model"] == "mohr-coulomb":
+        missing = [k for k in ("c", "phi") if k not in mat]
+        if missing:
+            raise ProblemError(f"model 'mohr-coulomb' needs {' and '.join(missing)}", key=f"material.{missing[0]}")
+        material = MohrCoulomb(material.E, material.nu, num(mat["c"], "material.c"), num(mat["phi"], "material.phi"),
+                               num(get("material", "psi", 0.0), "material.psi"), material.density)
+        if plane != "strain":
+            raise ProblemError("the Mohr-Coulomb model is implemented in plane strain; set problem.plane = \"strain\"",
+                               key="problem.plane")
     loading_raw = raw.get("loading", {})
     loading = Loading(**{k: (num(v, f"loading.{k}") if k == "tolerance" else v) for k, v in loading_raw.items()})
 
@@ -283,7 +293,9 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         "geometry": {k: [{sh.kind: [list(v) if isinstance(v, tuple) else v for v in sh.data]} for sh in shapes]
                      for k, shapes in (("add", geometry.add), ("subtract", geometry.subtract))},
         "nodes": nodes.as_dict(),
-        "material": {"model": mat["model"], "E": material.E, "nu": material.nu, "density": material.density},
+        "material": {"model": mat["model"], "E": material.E, "nu": material.nu, "density": material.density,
+                     **({"c": material.c, "phi": material.phi, "psi": material.psi}
+                        if isinstance(material, MohrCoulomb) else {})},
         "method": method.as_dict(),
         "constraint": [{k: str(v) for k, v in c.items()} for c in raw.get("constraint", [])],
         "traction": [{k: str(v) for k, v in c.items()} for c in raw.get("traction", [])],

@@ -17,6 +17,10 @@ def solve(case: Case, solver: str = "ctm-rpim", element: str = "q1") -> Result:
         from reference_fem import solve_fem
         return solve_fem(case, element)
     if case.problem.analysis == "quasi-static":
+        from .mohr_coulomb import MohrCoulomb
+        if isinstance(case.problem.material, MohrCoulomb):     # small strain: never re-tracked
+            from .elastoplastic import solve_elastoplastic
+            return solve_elastoplastic(case)
         if case.method.formulation == "updated-lagrangian":
             from .updated_lagrangian import solve_updated_lagrangian
             return solve_updated_lagrangian(case)

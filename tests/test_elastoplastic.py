@@ -1,0 +1,61 @@
+"""Small-strain Mohr-Coulomb CTM-RPIM (issue 5, first solver): a plane-strain block compressed between
+smooth platens reaches the analytical uniaxial plateau, -2 c cos(phi) / (1 - sin(phi)) (Tresca: -2 c),
+read as the reaction on the loaded face; the history is committed only at converged increments."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from verify import check
+
+import ctmrpim.elastoplastic as elastoplastic
+from ctmrpim.cli import load_target
+
+BLOCK = Path(__file__).parent / "data" / "mc_block.toml"
+
+
+def plateau_reaction(phi: float) -> tuple[float, float, object]:
+    captured = {}
+    step_loads = elastoplastic.step_loads
+
+    def spy(n, loading, fixed, values, assemble, solve, on_converged):
+        path = step_loads(n, loading, fixed, values, assemble, solve, on_converged)
+        captured.update(assemble=assemble, U=path.U)
+        return path
+
+    elastoplastic.step_loads = spy
+    try:
+        case = load_target(str(BLOCK), [f"parameters.phi={phi!r}"])
+        r = elastoplastic.solve_elastoplastic(case)
+    finally:
+        elastoplastic.step_loads = step_loads
+    _, f_int, _ = captured["assemble"](captured["U"], 1.0)
+    top = np.isclose(r.points[:, 1], 1.0)
+    reaction = -f_int.reshape(-1, 2)[top, 1].sum()            # compressive force on the 1 m wide top
+    mat = case.problem.material
+    exact = 2.0 * mat.c * math.cos(math.radians(phi)) / (1.0 - math.sin(math.radians(phi)))
+    return reaction, exact, r
+
+
+@pytest.mark.parametrize("phi, key", [(0.001, "mc-block-tresca-plateau"), (30.0, "mc-block-plateau")])
+def test_compressed_block_reaches_the_plateau(phi: float, key: str) -> None:
+    reaction, exact, r = plateau_reaction(phi)
+    check(key, abs(reaction / exact - 1.0))
+    assert r.history[-1]["converged"] and r.history[-1]["plastic_points"] > 0
+    assert r.counts["plastic_points"] == r.history[-1]["plastic_points"]
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda t: t.replace("phi = \"phi\"\n", ""), "needs phi"),
+    (lambda t: t.replace('plane = "strain"', 'plane = "stress"'), "plane strain"),
+    (lambda t: t.replace("psi = 0.0", "psi = 40.0"), "material.psi"),
+])
+def test_bad_mohr_coulomb_input_names_the_key(tmp_path, change, message: str) -> None:
+    from ctmrpim.errors import ProblemError
+
+    path = tmp_path / "block.toml"
+    path.write_text(change(BLOCK.read_text()))
+    with pytest.raises(ProblemError, match=message):
+        load_target(str(path), [])
