@@ -2,7 +2,8 @@
 
 The finite element counterpart of :func:`ctmrpim.total_lagrangian.solve_total_lagrangian`: the same
 Case (neo-Hookean material in plane strain, dead tractions and pressures on the reference boundary,
-prescribed displacements scaled by the load factor) on a mesh of the same field nodes, optionally
+follower tractions turning with their segment or with their whole face, prescribed displacements
+scaled by the load factor) on a mesh of the same field nodes, optionally
 refined ``refine`` times for a much finer reference. Loads are stepped by the same driver as the
 meshfree solver (:func:`ctmrpim.load_stepping.step_loads`: Newton-Raphson, reported cut-backs).
 
@@ -28,7 +29,8 @@ from ctmrpim.problem_file import Case
 from ctmrpim.result import Result, probe_record
 
 from .mesh import FemMesh, build_mesh
-from .solve import FACET_ORDER, SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate, _selected_facets, _value
+from .solve import (FACET_ORDER, SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate, _selected_facets,
+                    _traction_form, _value)
 
 #: Quadrature degree of f_int and K (P, A are not polynomial: one order above the linear need for P2).
 TANGENT_ORDER = {"q1": 2, "p1": 1, "p2": 4}
@@ -81,18 +83,19 @@ def _follower_stiffness_form(u, v, w):
     return -(drx * v[0] + dry * v[1])
 
 
-def _follower_loads(problem, fm: FemMesh, vec, tol: float) -> list[tuple[FacetBasis, np.ndarray, np.ndarray]]:
-    """Facet bases and nominal tractions of the follower tractions that turn with their segment."""
+def _follower_tractions(problem, fm: FemMesh, vec, tol: float, turn: str
+                        ) -> list[tuple[np.ndarray, FacetBasis, np.ndarray, np.ndarray]]:
+    """Facets, facet basis and nominal tractions of the follower tractions that turn as ``turn``."""
     out = []
     for i, tr in enumerate(problem.tractions):
-        if not tr.follower or tr.turn != "segment":
+        if not (tr.follower and tr.turn == turn):
             continue
         _, facets = _selected_facets(tr.where, fm, tol)
         if len(facets) == 0:
             raise ProblemError(f"where = {tr.where.text!r} selects no boundary segment", key=f"traction[{i}]")
         fb = FacetBasis(fm.mesh, vec, facets=facets, intorder=FACET_ORDER)
         xq = np.asarray(fb.global_coordinates())
-        out.append((fb, _value(tr.tx, xq[0], xq[1]), _value(tr.ty, xq[0], xq[1])))
+        out.append((facets, fb, _value(tr.tx, xq[0], xq[1]), _value(tr.ty, xq[0], xq[1])))
     return out
 
 
@@ -112,16 +115,8 @@ class FaceFollower:
     def __init__(self, problem, fm: FemMesh, vec, basis, tol: float):
         self.faces: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         facets_all, F0, F90 = [], np.zeros(basis.N), np.zeros(basis.N)
-        for i, tr in enumerate(problem.tractions):
-            if not (tr.follower and tr.turn == "face"):
-                continue
-            _, facets = _selected_facets(tr.where, fm, tol)
-            if len(facets) == 0:
-                raise ProblemError(f"where = {tr.where.text!r} selects no boundary segment", key=f"traction[{i}]")
-            fb = FacetBasis(fm.mesh, vec, facets=facets, intorder=FACET_ORDER)
-            xq = np.asarray(fb.global_coordinates())
-            tx, ty = _value(tr.tx, xq[0], xq[1]), _value(tr.ty, xq[0], xq[1])
-            F0 += problem.thickness * LinearForm(lambda v, w: w.tx * v[0] + w.ty * v[1]).assemble(fb, tx=tx, ty=ty)
+        for facets, fb, tx, ty in _follower_tractions(problem, fm, vec, tol, "face"):
+            F0 += problem.thickness * _traction_form.assemble(fb, tx=tx, ty=ty)
             F90 += problem.thickness * _rotated_traction_form.assemble(fb, tx=tx, ty=ty)
             facets_all.append(facets)
         if not facets_all:
@@ -225,7 +220,7 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
 
     series: list[dict] = []
 
-    followers = _follower_loads(problem, fm, vec, tol)
+    followers = [(fb, tx, ty) for _, fb, tx, ty in _follower_tractions(problem, fm, vec, tol, "segment")]
     faces = FaceFollower(problem, fm, vec, basis, tol)
 
     def assemble(U: np.ndarray, factor: float):
