@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import assembly
 from .boundary_loads import BoundaryLoads
 from .errors import ProblemError
 from .lagrangian_operators import gradient_operator, internal_force, tangent
 from .linear_solver import solve_constrained
 from .linear_static import Timer, build_configuration
 from .load_stepping import step_loads
-from . import assembly
 from .mohr_coulomb import ELASTIC, MohrCoulomb
 from .problem_file import Case
 from .result import Result, probe_record
@@ -76,6 +76,9 @@ def solve_elastoplastic(case: Case) -> Result:
     def solve(K, residual):
         return solve_constrained(K, residual, conf.fixed, np.zeros(len(conf.fixed)), "superlu")
 
+    def probe_displacements(u: np.ndarray) -> np.ndarray:
+        return np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
+
     def nodal(values: np.ndarray) -> np.ndarray:
         from .state_transfer import project_to_nodes
         return project_to_nodes(sf.N, w, values)
@@ -89,7 +92,7 @@ def solve_elastoplastic(case: Case) -> Result:
         series.append({"load_factor": factor, "u": u.copy(), "stress": nodal(stress[:, :3])})
         out = {"plastic_points": plastic}
         if sf_p is not None:
-            up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
+            up = probe_displacements(u)
             out.update({p.name: {"x": p.x, "y": p.y, "ux": float(up[i, 0]), "uy": float(up[i, 1])}
                         for i, p in enumerate(problem.probes)})
         return out
@@ -101,8 +104,7 @@ def solve_elastoplastic(case: Case) -> Result:
     stress_nodes = nodal(committed["stress"][:, :3])
     probes = {}
     if sf_p is not None:
-        up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
-        sp_ = sf_p.N @ stress_nodes
+        up, sp_ = probe_displacements(u), sf_p.N @ stress_nodes
         probes = {p.name: probe_record(p.x, p.y, up[i], sp_[i]) for i, p in enumerate(problem.probes)}
     timer.lap("postprocess")
     sizes = sf.support_sizes
