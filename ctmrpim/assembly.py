@@ -81,6 +81,15 @@ def point_load_vector(nodes: np.ndarray, problem, rpim: dict) -> np.ndarray:
     return F
 
 
+def body_force_vector(N: sp.csr_matrix, weights: np.ndarray, problem) -> np.ndarray:
+    """F = sum_p N_p^T b w_p over the integration points, b = density * gravity (Eq. 6, body term);
+    ``weights`` include the thickness."""
+    bx, by = problem.body_force
+    if bx == 0.0 and by == 0.0:
+        return np.zeros(2 * N.shape[1])
+    return load_vector(N, weights, np.full(N.shape[0], bx), np.full(N.shape[0], by))
+
+
 def strain(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, u: np.ndarray) -> np.ndarray:
     """(m, 3) exx, eyy, gxy at the rows' points from nodal displacements u (n, 2)."""
     return np.c_[dNdx @ u[:, 0], dNdy @ u[:, 1], dNdy @ u[:, 0] + dNdx @ u[:, 1]]

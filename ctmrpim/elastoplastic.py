@@ -53,6 +53,7 @@ def solve_elastoplastic(case: Case) -> Result:
     loads = BoundaryLoads(conf.sf_traction.N, q.weights * problem.thickness, conf.tx, conf.ty, q.ends, q.follower,
                           nodes[q.ends[:, 1]] - nodes[q.ends[:, 0]],
                           problem.thickness * assembly.point_load_vector(nodes, problem, conf.rpim))
+    F_body = assembly.body_force_vector(sf.N, w, problem)          # gravity, ramped with the load factor
     probe_xy = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
     sf_p = shape_functions(nodes, probe_xy, derivatives=False, **conf.rpim) if len(probe_xy) else None
     timer.lap("assembly")
@@ -69,7 +70,7 @@ def solve_elastoplastic(case: Case) -> Result:
         stress, _ = material.update(committed["stress"], de)
         Dt = material.tangent(committed["stress"], de)
         A = TO_P[None] @ Dt @ FROM_GRAD[None]                       # (m, 4, 4) = dP / d grad u
-        f_ext, _ = loads.forces(nodes, factor)
+        f_ext = loads.forces(nodes, factor)[0] + factor * F_body
         P = stress[:, :3] @ TO_P.T
         return f_ext, internal_force(G, P, w, GT), tangent(G, A, w, GT)
 

@@ -131,6 +131,7 @@ def solve_ctmrpim(case: Case) -> Result:
     K = assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights * problem.thickness, D)
     F = assembly.load_vector(sf_t.N, traction_q.weights * problem.thickness, tx, ty)
     F += problem.thickness * assembly.point_load_vector(nodes, problem, rpim)
+    F += assembly.body_force_vector(sf.N, quad.weights * problem.thickness, problem)
     timer.lap("assembly")
 
     U = solve_constrained(K, F, fixed, fixed_values, method.solver)

@@ -96,6 +96,7 @@ class Problem:
     analysis: str = "linear"
     plane: str = "stress"
     thickness: float = 1.0
+    gravity: tuple[float, float] = (0.0, 0.0)     # acceleration; body force density * gravity
     parameters: dict[str, float] = field(default_factory=dict)
     constraints: list[Constraint] = field(default_factory=list)
     tractions: list[Traction] = field(default_factory=list)
@@ -106,3 +107,9 @@ class Problem:
 
     def D(self) -> np.ndarray:
         return self.material.D(self.plane)
+
+    @property
+    def body_force(self) -> tuple[float, float]:
+        """Force per unit volume, density * gravity."""
+        rho = self.material.density
+        return rho * self.gravity[0], rho * self.gravity[1]

@@ -28,7 +28,7 @@ from .nodes import NodeSpec
 from .problem import Constraint, ExactSolution, PointLoad, Pressure, Probe, Problem, Traction
 
 SECTIONS: dict[str, set[str] | None] = {
-    "problem": {"name", "analysis", "plane", "thickness", "description"},
+    "problem": {"name", "analysis", "plane", "thickness", "description", "gravity"},
     "parameters": None,  # any names
     "geometry": {"add", "subtract"},
     "nodes": {"grid", "spacing", "file"},
@@ -166,6 +166,10 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     if plane not in ("stress", "strain"):
         raise ProblemError(f"plane must be 'stress' or 'strain', not {plane!r}", key="problem.plane")
     thickness = num(get("problem", "thickness", 1.0), "problem.thickness")
+    gravity_raw = get("problem", "gravity", [0.0, 0.0])
+    if not isinstance(gravity_raw, list) or len(gravity_raw) != 2:
+        raise ProblemError(f"{gravity_raw!r} must be [gx, gy] (an acceleration)", key="problem.gravity")
+    gravity = tuple(num(v, "problem.gravity") for v in gravity_raw)
     if not thickness > 0:
         raise ProblemError(f"thickness = {thickness} must be > 0", key="problem.thickness")
 
@@ -253,7 +257,7 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         raise ProblemError("no [[constraint]]: the body is free to move rigidly", key="constraint")
 
     problem = Problem(name=str(prob["name"]), geometry=geometry, material=material, analysis=analysis,
-                      plane=plane, thickness=thickness, parameters=params, constraints=constraints,
+                      plane=plane, thickness=thickness, gravity=gravity, parameters=params, constraints=constraints,
                       tractions=tractions, pressures=pressures, probes=probes, exact=exact,
                       point_loads=point_loads)
 
@@ -287,7 +291,8 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
                            "\"updated-lagrangian\")", key="material.model")
 
     resolved = {
-        "problem": {"name": problem.name, "analysis": analysis, "plane": plane, "thickness": thickness},
+        "problem": {"name": problem.name, "analysis": analysis, "plane": plane, "thickness": thickness,
+                    "gravity": list(gravity)},
         "parameters": params,
         # the shapes with their expressions evaluated ("-W/2" -> -6.0), as the solver saw them
         "geometry": {k: [{sh.kind: [list(v) if isinstance(v, tuple) else v for v in sh.data]} for sh in shapes]

@@ -46,6 +46,9 @@ def solve_total_lagrangian(case: Case) -> Result:
     if problem.plane != "strain":
         raise ProblemError("the neo-Hookean model is implemented in plane strain; set problem.plane = \"strain\"",
                            key="problem.plane")
+    if any(problem.body_force):
+        raise ProblemError("gravity is not in the large-deformation solvers yet (a Mohr-Coulomb or linear "
+                           "analysis takes it)", key="problem.gravity")
     timer = Timer()
     conf = build_configuration(case, timer)
     disc, rpim, sf, sf_t = conf.disc, conf.rpim, conf.sf, conf.sf_traction

@@ -324,6 +324,9 @@ def solve_updated_lagrangian(case: Case) -> Result:
     increment (and one per cut-back), ``Result.series`` the configuration after each increment with
     its tracked boundary."""
     problem = case.problem
+    if any(problem.body_force):
+        raise ProblemError("gravity is not in the large-deformation solvers yet (a Mohr-Coulomb or linear "
+                           "analysis takes it)", key="problem.gravity")
     timer = Timer()
     body, conf = adaptive_body(case, timer)
     update, X, d_c = body.update, body.X, body.d_c

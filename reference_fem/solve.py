@@ -51,6 +51,9 @@ def solve_fem(case: Case, element: str = "q1") -> Result:
     D = problem.D()
     K = problem.thickness * _stiffness_form(D).assemble(basis)
     F = problem.thickness * _load_vector(problem, fm, vec, tol, basis.N)
+    bx, by = problem.body_force
+    if bx or by:                                       # gravity: int (density g) . v dx
+        F += problem.thickness * LinearForm(lambda v, w: bx * v[0] + by * v[1]).assemble(basis)
     fixed, values = _constrained_dofs(problem, fm, basis, tol)
     t2 = time.perf_counter()
 

@@ -67,7 +67,8 @@ def test_summary_holds_the_resolved_input(run) -> None:
     p = s["parameters"]
     assert set(p) >= {"problem", "parameters", "geometry", "nodes", "material", "method", "constraint",
                       "traction", "pressure", "probe", "exact", "derived"}
-    assert p["problem"] == {"name": "cantilever", "analysis": "linear", "plane": "stress", "thickness": 1.0}
+    assert p["problem"] == {"name": "cantilever", "analysis": "linear", "plane": "stress", "thickness": 1.0,
+                            "gravity": [0.0, 0.0]}
     assert p["parameters"] == {"P": -1000.0, "E": 3.0e7, "nu": 0.3, "L": 48.0, "W": 12.0, "I": 144.0}
     assert p["geometry"] == {"add": [{"rectangle": [0.0, -6.0, 48.0, 6.0]}], "subtract": []}
     assert p["nodes"] == {"grid": [33, 9]}
@@ -81,7 +82,7 @@ def test_summary_holds_the_resolved_input(run) -> None:
     assert p["derived"]["d_c"] == pytest.approx(d_c, rel=1e-14)
     assert p["derived"]["support_radius"] == pytest.approx(4.0 * d_c, rel=1e-14)
     # the defaults that were applied are listed
-    assert s["defaults_applied"] == ["method.boundary = 'alpha'", "method.solver = 'auto'",
+    assert s["defaults_applied"] == ["problem.gravity = [0.0, 0.0]", "method.boundary = 'alpha'", "method.solver = 'auto'",
                                      "method.match_tolerance = 0.01", "method.formulation = 'updated-lagrangian'",
                                      "method.point_regeneration = 0.0"]
 

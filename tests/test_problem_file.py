@@ -112,10 +112,11 @@ def test_defaults_are_recorded(tmp_path: Path) -> None:
     case = load_case(write(tmp_path, MINIMAL))
     assert set(case.defaults) == {
         "problem.analysis = 'linear'", "problem.plane = 'stress'", "problem.thickness = 1.0",
-        "material.density = 0.0",
+        "problem.gravity = [0.0, 0.0]", "material.density = 0.0",
         *(f"method.{k} = {v.default!r}" for k, v in Method.__dataclass_fields__.items())}
     assert case.method == Method()
-    assert case.resolved["problem"] == {"name": "plate", "analysis": "linear", "plane": "stress", "thickness": 1.0}
+    assert case.resolved["problem"] == {"name": "plate", "analysis": "linear", "plane": "stress", "thickness": 1.0,
+                                        "gravity": [0.0, 0.0]}
     assert case.resolved["material"]["density"] == 0.0
     given = load_case(write(tmp_path, MINIMAL + "\n[method]\neta = 3.0\n"))
     assert "method.eta = 5.0" not in given.defaults and given.method.eta == 3.0
