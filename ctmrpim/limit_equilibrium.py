@@ -1,0 +1,121 @@
+"""Limit-equilibrium reference for slopes: Bishop's simplified method on circular slips, searched.
+
+For a circle (centre xc, yc, radius R) the sliding mass between the two points where the lower arc
+meets the ground surface is cut into vertical slices of width b, weight W = gamma b h and base
+inclination alpha (positive where the base dips towards the toe, here to the right: the slope faces
++x). Bishop's simplified method (moment equilibrium about the centre, inter-slice shear neglected):
+
+    FS = sum (c b + W tan(phi)) / m_alpha  /  sum W sin(alpha),   m_alpha = cos(alpha) + sin(alpha) tan(phi) / FS,
+
+solved by fixed-point iteration. The critical circle is searched over a grid of centres and radii
+(the base of the model, ``base``, limits how deep an arc may go), then refined with Nelder-Mead.
+No pore pressure. The slope is given by its ground surface, a polyline y(x) from left to right.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize
+
+SLICES = 100
+
+
+@dataclass
+class SlipCircle:
+    fs: float
+    xc: float
+    yc: float
+    radius: float
+    x_entry: float
+    x_exit: float
+
+
+def top_surface(body) -> np.ndarray:
+    """Ground surface (k, 2) of a body (a :class:`ctmrpim.geometry.Geometry` or a shapely polygon):
+    the highest boundary point above each vertex abscissa."""
+    import shapely
+
+    poly = getattr(body, "region", body)
+    xs = np.unique(np.asarray(poly.exterior.coords)[:, 0])
+    _, y0, _, y1 = poly.bounds
+    tops = []
+    for x in xs:     # at the end abscissae the vertical line touches the boundary only: still its top
+        cut = poly.intersection(shapely.LineString([(x, y0 - 1.0), (x, y1 + 1.0)]))
+        tops.append(cut.bounds[3])
+    return np.c_[xs, tops]
+
+
+def bishop(surface: np.ndarray, gamma: float, c: float, phi: float, xc: float, yc: float, radius: float,
+           base: float = -np.inf, slices: int = SLICES) -> SlipCircle | None:
+    """Bishop's factor of safety of one circle; None where the circle does not cut a sliding mass
+    (fewer than two crossings of the surface, or an arc below ``base``)."""
+    xs = np.linspace(surface[0, 0], surface[-1, 0], 4001)
+    ground = np.interp(xs, surface[:, 0], surface[:, 1])
+    inside = np.abs(xs - xc) < radius
+    arc = np.full_like(xs, np.inf)
+    arc[inside] = yc - np.sqrt(radius**2 - (xs[inside] - xc) ** 2)
+    below = arc < ground
+    if below.sum() < 3 or yc - radius < base - 1e-9:
+        return None
+    idx = np.flatnonzero(below)
+    if np.any(np.diff(idx) != 1):          # the arc leaves and re-enters the ground: not one mass
+        return None
+    xa, xb = xs[idx[0]], xs[idx[-1]]
+    edges = np.linspace(xa, xb, slices + 1)
+    xm = 0.5 * (edges[:-1] + edges[1:])
+    b = np.diff(edges)
+    dx = xm - xc
+    root = np.sqrt(np.maximum(radius**2 - dx**2, 1e-300))
+    h = np.interp(xm, surface[:, 0], surface[:, 1]) - (yc - root)
+    h = np.maximum(h, 0.0)
+    W = gamma * b * h
+    alpha = np.arctan2(-dx, root)          # base dips to the right (towards the toe) where x < xc
+    tphi = np.tan(np.radians(phi))
+    driving = np.sum(W * np.sin(alpha))
+    if driving <= 0.0:
+        return None
+    fs = 1.0
+    for _ in range(200):
+        m = np.cos(alpha) + np.sin(alpha) * tphi / fs
+        if np.any(m <= 0.05):              # Bishop's m_alpha breaks down: the circle is unrealistic
+            return None
+        new = np.sum((c * b + W * tphi) / m) / driving
+        if abs(new - fs) <= 1e-10 * new:
+            fs = new
+            break
+        fs = new
+    return SlipCircle(float(fs), float(xc), float(yc), float(radius), float(xa), float(xb))
+
+
+def critical_circle(surface: np.ndarray, gamma: float, c: float, phi: float, base: float = -np.inf,
+                    grid: int = 24) -> SlipCircle:
+    """The circle of least Bishop factor of safety: a grid over centres above the slope and radii,
+    refined by Nelder-Mead from the best few."""
+    x0, x1 = surface[0, 0], surface[-1, 0]
+    ytop, ybot = surface[:, 1].max(), surface[:, 1].min()
+    height = ytop - min(ybot, base if np.isfinite(base) else ybot)
+    best: list[SlipCircle] = []
+    for xc in np.linspace(x0, x1, grid):
+        for yc in np.linspace(ytop + 0.1 * height, ytop + 3.0 * height, grid):
+            deepest = yc - (base if np.isfinite(base) else ybot - height)
+            for radius in np.linspace(0.2 * (yc - ybot), deepest, grid):
+                s = bishop(surface, gamma, c, phi, xc, yc, radius, base)
+                if s is not None:
+                    best.append(s)
+    if not best:
+        raise ValueError("no admissible slip circle found")
+    best.sort(key=lambda s: s.fs)
+
+    def objective(v):
+        s = bishop(surface, gamma, c, phi, *v, base=base)
+        return s.fs if s is not None else 1e9
+
+    result = best[0]
+    for start in best[:5]:
+        opt = minimize(objective, [start.xc, start.yc, start.radius], method="Nelder-Mead",
+                       options={"xatol": 1e-4, "fatol": 1e-7, "maxiter": 2000})
+        s = bishop(surface, gamma, c, phi, *opt.x, base=base)
+        if s is not None and s.fs < result.fs:
+            result = s
+    return result
