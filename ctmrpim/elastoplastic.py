@@ -77,9 +77,6 @@ def solve_elastoplastic(case: Case) -> Result:
     def solve(K, residual):
         return solve_constrained(K, residual, conf.fixed, np.zeros(len(conf.fixed)), "superlu")
 
-    def probe_displacements(u: np.ndarray) -> np.ndarray:
-        return np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
-
     def nodal(values: np.ndarray) -> np.ndarray:
         from .state_transfer import project_to_nodes
         return project_to_nodes(sf.N, w, values)
@@ -93,7 +90,7 @@ def solve_elastoplastic(case: Case) -> Result:
         series.append({"load_factor": factor, "u": u.copy(), "stress": nodal(stress[:, :3])})
         out = {"plastic_points": plastic}
         if sf_p is not None:
-            up = probe_displacements(u)
+            up = sf_p.N @ u
             out.update({p.name: {"x": p.x, "y": p.y, "ux": float(up[i, 0]), "uy": float(up[i, 1])}
                         for i, p in enumerate(problem.probes)})
         return out
@@ -105,7 +102,7 @@ def solve_elastoplastic(case: Case) -> Result:
     stress_nodes = nodal(committed["stress"][:, :3])
     probes = {}
     if sf_p is not None:
-        up, sp_ = probe_displacements(u), sf_p.N @ stress_nodes
+        up, sp_ = sf_p.N @ u, sf_p.N @ stress_nodes
         probes = {p.name: probe_record(p.x, p.y, up[i], sp_[i]) for i, p in enumerate(problem.probes)}
     timer.lap("postprocess")
     sizes = sf.support_sizes

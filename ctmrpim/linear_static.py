@@ -144,7 +144,7 @@ def solve_ctmrpim(case: Case) -> Result:
     if problem.probes:
         pp = np.array([[p.x, p.y] for p in problem.probes])
         sf_p = shape_functions(nodes, pp, **rpim)
-        up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
+        up = sf_p.N @ u
         sp_ = assembly.strain(sf_p.dNdx, sf_p.dNdy, u) @ D.T
         probes = {p.name: probe_record(p.x, p.y, up[i], sp_[i]) for i, p in enumerate(problem.probes)}
     errors: dict = {}
@@ -152,7 +152,7 @@ def solve_ctmrpim(case: Case) -> Result:
         eq = integration_points(problem.geometry.loops(), ERROR_CELL * d_c, ERROR_CELL * d_c, ERROR_GAUSS,
                                 mode="exact", min_band=ERROR_MIN_BAND * d_c)
         sf_e = shape_functions(nodes, eq.points, **rpim)
-        u_e = np.c_[sf_e.N @ u[:, 0], sf_e.N @ u[:, 1]]
+        u_e = sf_e.N @ u
         s_e = assembly.strain(sf_e.dNdx, sf_e.dNdy, u) @ D.T
         errors = {**relative_errors(problem, eq.points, eq.weights, u_e, s_e),
                   "probes": probe_errors(problem, probes)}

@@ -58,7 +58,8 @@ def hughes_winget(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return de, inv2(eye - half_w) @ (eye + half_w)
 
 
-def _check_orientation(f: np.ndarray) -> np.ndarray:
+def check_orientation(f: np.ndarray) -> np.ndarray:
+    """det f, or a ProblemError naming the first point where the increment inverts the material."""
     J = det2(f.real)
     if np.any(J <= 0):
         i = int(np.argmin(J))
@@ -100,7 +101,7 @@ class HypoelasticUpdate:
         return det2(f)[:, None, None] * sig @ inv2(f).transpose(0, 2, 1)
 
     def advance(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
-        _check_orientation(f)
+        check_orientation(f)
         sig, szz = self._update(f, state)
         return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1], szz]
 
@@ -141,7 +142,7 @@ class LeftCauchyGreenUpdate:
         return det2(f)[:, None, None] * self._cauchy(b) @ inv2(f).transpose(0, 2, 1)
 
     def advance(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
-        _check_orientation(f)
+        check_orientation(f)
         b = f @ self._b(state) @ f.transpose(0, 2, 1)
         return np.c_[b[:, 0, 0], b[:, 1, 1], b[:, 0, 1]]
 

@@ -90,7 +90,7 @@ def solve_total_lagrangian(case: Case) -> Result:
         series.append({"load_factor": factor, "u": u.copy(), "stress": _cauchy(material, G_nodes, U)})
         if sf_p is None:
             return {}
-        up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
+        up = sf_p.N @ u
         return {p.name: {"x": p.x, "y": p.y, "ux": float(up[i, 0]), "uy": float(up[i, 1])}
                 for i, p in enumerate(problem.probes)}
 
@@ -102,7 +102,7 @@ def solve_total_lagrangian(case: Case) -> Result:
     stress = series[-1]["stress"] if series else _cauchy(material, G_nodes, U)
     probes = {}
     if sf_p is not None:
-        up = np.c_[sf_p.N @ u[:, 0], sf_p.N @ u[:, 1]]
+        up = sf_p.N @ u
         sig = _cauchy(material, gradient_operator(sf_p.dNdx, sf_p.dNdy), U)
         probes = {p.name: probe_record(p.x, p.y, up[i], sig[i]) for i, p in enumerate(problem.probes)}
     timer.lap("postprocess")

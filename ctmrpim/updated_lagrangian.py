@@ -49,8 +49,8 @@ from .linear_solver import solve_constrained
 from .linear_static import Configuration, Timer, build_configuration
 from .load_stepping import step_loads
 from .material import LinearElastic
-from .objective_stress import (HypoelasticUpdate, LeftCauchyGreenUpdate, complex_step_tangent, det2,
-                               inv2)
+from .objective_stress import (HypoelasticUpdate, LeftCauchyGreenUpdate, check_orientation, complex_step_tangent,
+                               det2, inv2)
 from .problem_file import Case
 from .result import Result, probe_record
 from .rpim import shape_functions
@@ -205,10 +205,7 @@ class AdaptiveBody:
         """F_ext, F_int and the tangent at the total displacement ``U`` (interleaved)."""
         du = U - self.U
         f = self.relative_gradient(du)
-        J = det2(f)
-        if np.any(J <= 0):
-            i = int(np.argmin(J))
-            raise ProblemError(f"det f = {J[i]:.3g} <= 0 at integration point #{i}: the increment inverts the material")
+        check_orientation(f)
         P = self.update.first_piola(f, self.state)
         A = complex_step_tangent(self.update, f, self.state)
         f_ext, K_load = self.loads.forces(self.x + du.reshape(-1, 2), factor)
@@ -233,11 +230,11 @@ class AdaptiveBody:
         d = du.reshape(-1, 2)
         w_moved = self.w * det2(f)
         N_old = self.sf.N
-        moved = self.points + np.c_[N_old @ d[:, 0], N_old @ d[:, 1]]
+        moved = self.points + N_old @ d
         strained = f @ self.strained
         self.U = U.copy()
         self.x = self.X + U.reshape(-1, 2)       # from the total, so prescribed values come out exact
-        self.material_x = self.material_x + np.c_[self.N_material @ d[:, 0], self.N_material @ d[:, 1]]
+        self.material_x = self.material_x + self.N_material @ d
         self.timer.lap("solve")
         skipped = None
         if rebuild:
