@@ -54,6 +54,17 @@ def describe(result: Result, case: Case) -> str:
     if "l2" in result.errors or "energy" in result.errors:
         lines.append("  relative errors: " + ", ".join(
             f"{k} {100 * result.errors[k]:.4g} %" for k in ("l2", "energy") if k in result.errors))
+    fos = result.outcome.get("factor_of_safety")
+    if fos is not None:
+        lines.append(f"  {c['levels']} strength-reduction levels ({fos['mode']}), {c['newton_iterations']} iterations, "
+                     f"{c['cutbacks']} cut-back(s), {c['tangents']} stiffness factorisation(s)")
+        for h in result.history:
+            lines.append("    " + _level_line(h))
+        if fos["stable"] is not None and fos["failed"] is not None:
+            lines.append(f"  factor of safety in [{fos['stable']:.4f}, {fos['failed']:.4f}] "
+                         f"(stable, failed by {fos['criterion'].split(':')[0]})")
+        else:
+            lines.append(f"  factor of safety not bracketed: stable up to {fos['stable']}, failed from {fos['failed']}")
     if "load_increments" in c:
         line = (f"  {c['load_increments']} load increments, {c['newton_iterations']} Newton iterations, "
                 f"{c['cutbacks']} cut-back(s)")
@@ -67,6 +78,14 @@ def describe(result: Result, case: Case) -> str:
     phases = ", ".join(f"{k.replace('_', ' ')} {v:.3f}" for k, v in t.items() if k != "total")
     lines.append(f"  time: {t['total']:.3f} s ({phases})")
     return "\n".join(lines)
+
+
+def _level_line(h: dict) -> str:
+    state = "stable" if h["stable"] else "FAILED"
+    if "criterion" in h:
+        state += f" ({h['criterion']})"
+    return (f"SRF {h['srf']:.4f}: {state}, {h['iterations']} iterations, {h['cutbacks']} cut-back(s), "
+            f"max |u| {h['max_displacement']:.4g}, {h['seconds']:.1f} s")
 
 
 def cmd_list(args: argparse.Namespace) -> int:
@@ -84,7 +103,9 @@ def _description(name: str) -> str:
 def cmd_run(args: argparse.Namespace) -> int:
     case = load_target(args.target, args.set or [])
     try:
-        result = solve(case, args.solver, args.element)
+        progress = None if args.quiet else (lambda level: print("  " + _level_line(level.record()), file=sys.stderr,
+                                                                    flush=True))
+        result = solve(case, args.solver, args.element, progress=progress)
     except ProblemError as exc:  # raised while solving, e.g. a selector that matches no node: name the file
         raise exc.at(source=case.source) from None
     suffix = "" if args.solver == "ctm-rpim" else f"-fem-{args.element}"

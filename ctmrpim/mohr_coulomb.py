@@ -156,6 +156,23 @@ class MohrCoulomb:
         return out, region
 
 
+def plastic_strain_increment(material: "MohrCoulomb", dstrain: np.ndarray, dstress: np.ndarray) -> np.ndarray:
+    """(m, 4) plastic strain increment (xx, yy, xy tensor, zz): the total increment (ezz = 0 in plane
+    strain) less the elastic one, C dsigma with the isotropic compliance."""
+    E, nu = material.E, material.nu
+    trace = dstress[:, 0] + dstress[:, 1] + dstress[:, 3]
+    elastic = ((1.0 + nu) * dstress - nu * trace[:, None] * np.array([1.0, 1.0, 0.0, 1.0])) / E
+    total = np.c_[dstrain[:, 0], dstrain[:, 1], 0.5 * dstrain[:, 2], np.zeros(len(dstrain))]
+    return total - elastic
+
+
+def equivalent_plastic_strain(plastic_strain: np.ndarray) -> np.ndarray:
+    """sqrt(2/3 e:e) of the deviatoric part e of a plastic strain (m, 4: xx, yy, xy tensor, zz)."""
+    mean = (plastic_strain[:, 0] + plastic_strain[:, 1] + plastic_strain[:, 3]) / 3.0
+    dev = plastic_strain[:, [0, 1, 3]] - mean[:, None]
+    return np.sqrt(2.0 / 3.0 * ((dev ** 2).sum(axis=1) + 2.0 * plastic_strain[:, 2] ** 2))
+
+
 def _principal(stress: np.ndarray):
     """Principal stresses (m, 3) sorted s1 >= s2 >= s3 (by real part) and what rebuilds the tensor:
     the in-plane unit eigenvector of the larger in-plane value and which sorted slot holds szz."""

@@ -62,6 +62,7 @@ def summary_dict(result: Result, source: str) -> dict[str, Any]:
         "timings": result.timings,
         "probes": result.probes,
         "errors": result.errors,
+        **result.outcome,
         **({"history": result.history} if result.history else {}),
     }
 
@@ -73,20 +74,20 @@ def write_summary(result: Result, out_dir: Path, source: str) -> Path:
 
 
 def _mesh(result: Result, u: np.ndarray, stress: np.ndarray, moved: bool,
-          boundary: np.ndarray | None = None) -> meshio.Mesh:
+          boundary: np.ndarray | None = None, fields: dict[str, np.ndarray] | None = None) -> meshio.Mesh:
     n = len(result.points)
     xy = result.points + u if moved else result.points
     blocks = result.cells if boundary is None else [("line", boundary)]
     cells = [("vertex", np.arange(n).reshape(-1, 1))] + [(k, np.asarray(v)) for k, v in blocks]
     return meshio.Mesh(np.c_[xy, np.zeros(n)], cells,
-                       point_data={"u": np.c_[u, np.zeros(n)], "stress": stress})
+                       point_data={"u": np.c_[u, np.zeros(n)], "stress": stress, **(fields or {})})
 
 
 def write_vtu(result: Result, out_dir: Path) -> Path:
     """Field nodes as vertex cells with point data u and stress; boundary / elements as further cells
     (reference configuration: warp by u in ParaView to see the deformed body)."""
     path = Path(out_dir) / "result.vtu"
-    mesh = _mesh(result, result.u, result.stress, moved=False)
+    mesh = _mesh(result, result.u, result.stress, moved=False, fields=result.fields)
     atomic_write(path, lambda p: meshio.write(p, mesh, file_format="vtu"))
     return path
 
@@ -102,10 +103,12 @@ def write_series(result: Result, out_dir: Path) -> list[Path]:
     entries, written = [], []
     for k, step in enumerate(result.series, start=1):
         name = f"series/step_{k:04d}.vtu"
-        mesh = _mesh(result, step["u"], step["stress"], moved=True, boundary=step.get("boundary"))
+        mesh = _mesh(result, step["u"], step["stress"], moved=True, boundary=step.get("boundary"),
+                     fields=step.get("fields"))
         atomic_write(out_dir / name, lambda p, m=mesh: meshio.write(p, m, file_format="vtu"))
         written.append(out_dir / name)
-        entries.append(f'    <DataSet timestep="{step["load_factor"]:.10g}" part="0" file="{name}"/>')
+        time = step["time"] if "time" in step else step["load_factor"]   # a strength reduction: the SRF
+        entries.append(f'    <DataSet timestep="{time:.10g}" part="0" file="{name}"/>')
     pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
            "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
     atomic_write_text(out_dir / "result.pvd", pvd)

@@ -25,6 +25,7 @@ from .material import LinearElastic
 from .mohr_coulomb import MohrCoulomb
 from .method import Method
 from .nodes import NodeSpec
+from .strength_reduction import StrengthReduction
 from .problem import Constraint, ExactSolution, PointLoad, Pressure, Probe, Problem, Traction
 
 SECTIONS: dict[str, set[str] | None] = {
@@ -40,7 +41,8 @@ SECTIONS: dict[str, set[str] | None] = {
     "probe": {"name", "at"},
     "point_load": {"at", "fx", "fy"},
     "exact": {"ux", "uy", "sxx", "syy", "sxy"},
-    "loading": {"steps", "tolerance", "max_iterations", "max_cutbacks"},
+    "loading": {"steps", "tolerance", "max_iterations", "max_cutbacks", "tangent"},
+    "strength-reduction": {"solver", "start", "step", "width", "max_srf", "steps", "values"},
 }
 LIST_SECTIONS = {"constraint", "traction", "pressure", "probe", "point_load"}
 REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E", "nu"],
@@ -49,10 +51,11 @@ REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E",
 #: Names people reach for instead of the file's keys, to suggest where difflib finds no close spelling.
 SYNONYMS = {"youngs": "E", "young": "E", "youngs_modulus": "E", "young_modulus": "E", "modulus": "E",
             "poisson": "nu", "poissons_ratio": "nu", "poisson_ratio": "nu", "rho": "density"}
-ANALYSES = ("linear", "quasi-static")
+ANALYSES = ("linear", "quasi-static", "strength-reduction")
 MATERIAL_MODELS = ("linear-elastic", "neo-hookean", "mohr-coulomb")
 #: the material models each analysis solves (quasi-static linear-elastic: the updated-Lagrangian rate form)
-ANALYSIS_MODELS = {"linear": ("linear-elastic",), "quasi-static": ("neo-hookean", "linear-elastic", "mohr-coulomb")}
+ANALYSIS_MODELS = {"linear": ("linear-elastic",), "quasi-static": ("neo-hookean", "linear-elastic", "mohr-coulomb"),
+                   "strength-reduction": ("mohr-coulomb",)}
 
 
 @dataclass(frozen=True)
@@ -63,8 +66,11 @@ class Loading:
     tolerance: float = 1e-8        # Newton: relative residual and displacement-increment norms
     max_iterations: int = 25       # Newton iterations per increment before a cut-back
     max_cutbacks: int = 8          # increment halvings before the solve gives up
+    tangent: str = "consistent"    # Newton's matrix; "elastic" (Mohr-Coulomb only): see ctmrpim.elastoplastic
 
     def __post_init__(self) -> None:
+        if self.tangent not in ("consistent", "elastic"):
+            raise ProblemError(f"{self.tangent!r} must be \"consistent\" or \"elastic\"", key="loading.tangent")
         for key, ok in (("steps", isinstance(self.steps, int) and self.steps >= 1),
                         ("tolerance", 0 < self.tolerance < 1),
                         ("max_iterations", isinstance(self.max_iterations, int) and self.max_iterations >= 1),
@@ -85,6 +91,7 @@ class Case:
     resolved: dict[str, Any] = field(default_factory=dict)
     defaults: list[str] = field(default_factory=list)
     loading: Loading = field(default_factory=Loading)
+    strength_reduction: StrengthReduction | None = None
 
 
 def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
@@ -197,6 +204,28 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
                                key="problem.plane")
     loading_raw = raw.get("loading", {})
     loading = Loading(**{k: (num(v, f"loading.{k}") if k == "tolerance" else v) for k, v in loading_raw.items()})
+    sr_raw = raw.get("strength-reduction")
+    if sr_raw is not None and analysis != "strength-reduction":
+        raise ProblemError("[strength-reduction] needs analysis = \"strength-reduction\"", key="problem.analysis")
+    strength_reduction = None
+    if analysis == "strength-reduction":
+        sr = {}
+        for key, spec in StrengthReduction.__dataclass_fields__.items():
+            if key not in (sr_raw or {}):
+                defaults.append(f"strength-reduction.{key} = {spec.default!r}")
+                continue
+            v = sr_raw[key]
+            if key == "values":
+                if not isinstance(v, list):
+                    raise ProblemError(f"{v!r} must be a list of SRF values", key="strength-reduction.values")
+                v = [num(e, "strength-reduction.values") for e in v]
+            elif key in ("start", "step", "width", "max_srf"):
+                v = num(v, f"strength-reduction.{key}")
+            sr[key] = v
+        strength_reduction = StrengthReduction(**sr)
+    if loading.tangent == "elastic" and mat["model"] != "mohr-coulomb":
+        raise ProblemError("tangent = \"elastic\" is the Mohr-Coulomb solver's iteration; large-deformation "
+                           "solvers use the consistent tangent", key="loading.tangent")
 
     constraints = []
     for i, c in enumerate(raw.get("constraint", [])):
@@ -309,10 +338,12 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         "point_load": [{"at": [p.x, p.y], "fx": p.fx, "fy": p.fy} for p in point_loads],
         "exact": {k: str(v) for k, v in raw.get("exact", {}).items()},
     }
-    if analysis == "quasi-static":
+    if analysis in ("quasi-static", "strength-reduction"):
         resolved["loading"] = asdict(loading)
+    if strength_reduction is not None:
+        resolved["strength-reduction"] = {**asdict(strength_reduction), "values": list(strength_reduction.values)}
     return Case(problem=problem, nodes=nodes, method=method, source=source, base_dir=base_dir,
-                resolved=resolved, defaults=defaults, loading=loading)
+                resolved=resolved, defaults=defaults, loading=loading, strength_reduction=strength_reduction)
 
 
 def _grid(value: Any, num) -> tuple[int, int]:

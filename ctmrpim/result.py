@@ -26,6 +26,8 @@ class Result:
     defaults: list[str] = field(default_factory=list)          # defaults that were applied
     history: list[dict[str, Any]] = field(default_factory=list)  # one entry per load increment
     series: list[dict[str, Any]] = field(default_factory=list)   # per converged increment: load_factor, u, stress
+    fields: dict[str, np.ndarray] = field(default_factory=dict)  # further nodal fields (plastic strain ...)
+    outcome: dict[str, Any] = field(default_factory=dict)        # headline results (factor_of_safety ...)
 
 
 def probe_record(x: float, y: float, u: np.ndarray, s: np.ndarray) -> dict[str, float]:

@@ -1,6 +1,8 @@
 """One entry point for every method that solves a Case: CTM-RPIM or the scikit-fem reference."""
 from __future__ import annotations
 
+from typing import Any, Callable
+
 from .problem_file import Case
 from .result import Result
 
@@ -8,14 +10,20 @@ METHODS = ("ctm-rpim", "fem")
 ELEMENTS = ("q1", "p1", "p2")
 
 
-def solve(case: Case, solver: str = "ctm-rpim", element: str = "q1") -> Result:
-    """Solve ``case`` with CTM-RPIM, or with scikit-fem ``element`` when ``solver == "fem"``."""
+def solve(case: Case, solver: str = "ctm-rpim", element: str = "q1",
+          progress: Callable[[Any], None] | None = None) -> Result:
+    """Solve ``case`` with CTM-RPIM, or with scikit-fem ``element`` when ``solver == "fem"``;
+    ``progress`` gets each strength-reduction level as it finishes."""
+    progress = progress or (lambda level: None)
     if solver == "fem":
         if case.problem.analysis == "quasi-static":
             from reference_fem.hyperelastic import solve_fem_hyperelastic
             return solve_fem_hyperelastic(case, element)
         from reference_fem import solve_fem
         return solve_fem(case, element)
+    if case.problem.analysis == "strength-reduction":
+        from .elastoplastic import solve_elastoplastic
+        return solve_elastoplastic(case, progress)
     if case.problem.analysis == "quasi-static":
         from .mohr_coulomb import MohrCoulomb
         if isinstance(case.problem.material, MohrCoulomb):     # small strain: never re-tracked

@@ -1,0 +1,225 @@
+"""Strength reduction (Section 3.3.1, Eqs. 38-39): the factor of safety of a body under gravity.
+
+The strengths are divided by the strength reduction factor SRF,
+
+    c' = c / SRF,       tan(phi') = tan(phi) / SRF,       tan(psi') = tan(psi) / SRF,
+
+(the paper reduces c and phi; psi is reduced the same way so that psi' <= phi' stays true; with psi = 0
+it stays 0), and the body is equilibrated under its full loads. A level is **failed** when Newton
+cannot reach equilibrium: the SRF sub-step was cut back ``loading.max_cutbacks`` times and still did
+not converge within ``loading.max_iterations`` iterations (the criterion recorded with every level;
+the displacement of the last iterate is recorded too, and grows without bound at a failed level).
+
+Search (``values`` empty): the gravity stage is solved once at SRF = ``start`` (loads ramped by the
+load stepping), then SRF rises by ``step`` from the last stable state, each level continuing from the
+converged state below it (as Kratos GeoMechanics and PLAXIS' Sum-Msf do); after the first failed level
+the interval [stable, failed] is bisected, again from the last stable state, until it is at most
+``width`` wide. The answer is the bracket [stable, failed], not one number.
+
+Sweep (``values = [...]``): each SRF is solved on its own from zero, gravity ramped at the reduced
+strength (Griffiths & Lane 1999); the paper's Fig. 19 plots these. The sweep study sends one case per
+value through the sweep executor so the levels run in parallel.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable
+
+import numpy as np
+
+from .errors import ProblemError
+from .mohr_coulomb import MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
+from .result import Result
+
+SOLVERS = ("newton",)
+CRITERION = ("non-convergence: Newton did not reach the residual and displacement tolerance within "
+             "loading.max_iterations iterations at an SRF sub-step cut back loading.max_cutbacks times")
+
+
+@dataclass(frozen=True)
+class StrengthReduction:
+    """The ``[strength-reduction]`` table of a problem file."""
+
+    solver: str = "newton"          # how each level is equilibrated
+    start: float = 1.0              # the SRF of the gravity stage (the search starts stable there)
+    step: float = 0.1               # SRF rise per level until the first failure
+    width: float = 0.01             # bisection stops when failed - stable <= width
+    max_srf: float = 5.0            # give up (no failure found) beyond this
+    steps: int = 4                  # SRF sub-steps per level (halved on non-convergence like load steps)
+    values: tuple[float, ...] = field(default=())   # sweep mode: these SRFs, each from zero
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "values", tuple(float(v) for v in self.values))
+        for key, ok, why in (
+                ("solver", self.solver in SOLVERS, f"must be one of {list(SOLVERS)}"),
+                ("start", self.start > 0, "must be > 0"),
+                ("step", self.step > 0, "must be > 0"),
+                ("width", 0 < self.width <= self.step, "must be > 0 and at most step"),
+                ("max_srf", self.max_srf > self.start, "must exceed start"),
+                ("steps", isinstance(self.steps, int) and self.steps >= 1, "must be an integer >= 1"),
+                ("values", all(v > 0 for v in self.values), "must all be > 0")):
+            if not ok:
+                raise ProblemError(f"{getattr(self, key)!r} {why}", key=f"strength-reduction.{key}")
+
+
+def reduced(material: MohrCoulomb, srf: float) -> MohrCoulomb:
+    """The material with its strength divided by ``srf`` (Eqs. 38-39)."""
+    def angle(a: float) -> float:
+        return math.degrees(math.atan(math.tan(math.radians(a)) / srf))
+    return replace(material, c=material.c / srf, phi=angle(material.phi), psi=angle(material.psi))
+
+
+@dataclass
+class Level:
+    """One strength-reduction level."""
+
+    srf: float
+    stable: bool
+    iterations: int
+    cutbacks: int
+    max_displacement: float          # converged state, or the last iterate of a failed level
+    seconds: float
+    criterion: str = ""              # a failed level: why; a stable one: how it was reached, where not its own
+    state: tuple[np.ndarray, ...] | None = None    # system snapshot of a stable level
+    trial: np.ndarray | None = None                # last iterate of a failed level
+    plastic: np.ndarray | None = None              # equivalent plastic strain at the points (failed: last iterate)
+    stress: np.ndarray | None = None               # stress (m, 4) at the points (failed: last iterate)
+
+    def record(self) -> dict[str, Any]:
+        return {"srf": self.srf, "stable": self.stable, "iterations": self.iterations, "cutbacks": self.cutbacks,
+                "max_displacement": self.max_displacement, "seconds": round(self.seconds, 3),
+                **({"criterion": self.criterion} if self.criterion else {})}
+
+
+def _max_displacement(U: np.ndarray) -> float:
+    return float(np.linalg.norm(U.reshape(-1, 2), axis=1).max())
+
+
+def _level(system, loading, material_at, load_at, srf_at: Callable[[float], float], fixed_values=None
+           ) -> tuple[Level, Level | None]:
+    """Run the path t = 0..1 from the committed state; returns the level at t = 1 (stable, or failed
+    at the sub-step that did not converge) and, for a failed level whose cut-back sub-steps got part of
+    the way, the stable level reached (the system is left there)."""
+    t0 = time.perf_counter()
+    path = system.run(loading, material_at, load_at, lambda t, U: {}, fixed_values=fixed_values,
+                      stop_on_failure=True)
+    seconds = time.perf_counter() - t0
+    if path.failed_at is None:
+        return Level(srf_at(1.0), True, path.newton_iterations, path.cutbacks, _max_displacement(system.U), seconds,
+                     state=system.snapshot(), plastic=equivalent_plastic_strain(system.plastic_strain),
+                     stress=system.stress.copy()), None
+    material = material_at(path.failed_at)
+    de = system.strain_increment(path.failed_trial)
+    trial_stress, _ = material.update(system.stress, de)
+    plastic = system.plastic_strain + plastic_strain_increment(material, de, trial_stress - system.stress)
+    failed = Level(srf_at(path.failed_at), False, path.newton_iterations, path.cutbacks,
+                   _max_displacement(path.failed_trial), seconds, criterion="non-convergence", trial=path.failed_trial,
+                   plastic=equivalent_plastic_strain(plastic), stress=trial_stress)
+    reached = [h["load_factor"] for h in path.history if h["converged"]]
+    if not reached:
+        return failed, None
+    return failed, Level(srf_at(reached[-1]), True, 0, 0, _max_displacement(system.U), 0.0, state=system.snapshot(),
+                         criterion="reached by the cut-back sub-steps of the next level",
+                         plastic=equivalent_plastic_strain(system.plastic_strain), stress=system.stress.copy())
+
+
+def gravity_level(system, loading, material: MohrCoulomb, srf: float) -> Level:
+    """Loads ramped from zero on the reduced material (the first stage of a search; one sweep level)."""
+    m = reduced(material, srf)
+    return _level(system, loading, lambda t: m, lambda t: t, lambda t: srf)[0]
+
+
+def search(system, loading, material: MohrCoulomb, settings: StrengthReduction,
+           progress: Callable[[Level], None] = lambda level: None) -> tuple[list[Level], Level, Level]:
+    """Bracket and bisect the factor of safety; returns (levels in order, last stable, first failed
+    of the final bracket). The system is left in the last stable state."""
+    first = gravity_level(system, loading, material, settings.start)
+    progress(first)
+    levels = [first]
+    if not first.stable:
+        raise ProblemError(f"the body fails under its loads already at SRF = {settings.start:g} (the gravity "
+                           "stage does not converge); lower strength-reduction.start", key="strength-reduction.start")
+    stable, failed = first, None
+    fixed_values = system.U[system.fixed].copy()
+    level_loading = replace(loading, steps=settings.steps)
+    while failed is None or failed.srf - stable.srf > settings.width * (1 + 1e-9):
+        target = stable.srf + settings.step if failed is None else 0.5 * (stable.srf + failed.srf)
+        if target > settings.max_srf:
+            raise ProblemError(f"no failure up to SRF = {settings.max_srf:g}; raise strength-reduction.max_srf",
+                               key="strength-reduction.max_srf")
+        system.restore(stable.state)
+        s0 = stable.srf
+        srf_at = lambda t, s0=s0, s1=target: s0 + t * (s1 - s0)   # noqa: E731
+        level, reached = _level(system, level_loading, lambda t: reduced(material, srf_at(t)), lambda t: 1.0, srf_at,
+                                fixed_values)
+        if reached is not None:   # the cut-back sub-steps converged part of the way: stable there
+            progress(reached)
+            levels.append(reached)
+            stable = reached
+        progress(level)
+        levels.append(level)
+        if level.stable:
+            stable = level
+        else:
+            failed = level
+    system.restore(stable.state)
+    return levels, stable, failed
+
+
+def sweep(system, loading, material: MohrCoulomb, values: tuple[float, ...],
+          progress: Callable[[Level], None] = lambda level: None) -> list[Level]:
+    """Each SRF on its own, gravity ramped from zero at the reduced strength."""
+    start = system.snapshot()
+    levels = []
+    for srf in values:
+        system.restore(start)
+        level = gravity_level(system, loading, material, srf)
+        progress(level)
+        levels.append(level)
+    return levels
+
+
+def bracket(levels: list[Level]) -> tuple[float | None, float | None]:
+    """(largest stable SRF below the smallest failed one, smallest failed SRF); None where absent."""
+    failed = min((lv.srf for lv in levels if not lv.stable), default=None)
+    stable = max((lv.srf for lv in levels if lv.stable and (failed is None or lv.srf < failed)), default=None)
+    return stable, failed
+
+
+def solve_strength_reduction(case, system, nodal: Callable[[np.ndarray], np.ndarray], base: Result,
+                             progress: Callable[[Level], None] = lambda level: None) -> Result:
+    """Run the ``[strength-reduction]`` of ``case`` on ``system`` (any discretisation) and fill
+    ``base`` (points, cells, counts, parameters of that discretisation) with the last stable state,
+    the levels in the history and the series, and the factor of safety as a bracket.
+    ``nodal(values at the points) -> values at base.points`` projects point values for output."""
+    settings: StrengthReduction = case.strength_reduction
+    material = case.problem.material
+    t0 = time.perf_counter()
+    if settings.values:
+        levels = sweep(system, case.loading, material, settings.values, progress)
+    else:
+        levels, _, _ = search(system, case.loading, material, settings, progress)
+    seconds = time.perf_counter() - t0
+    stable, failed = bracket(levels)
+    series = []
+    for lv in levels:
+        U = lv.state[0] if lv.stable else lv.trial
+        series.append({"time": lv.srf, "load_factor": 1.0, "u": U.reshape(-1, 2), "stress": nodal(lv.stress[:, :3]),
+                       "fields": {"plastic_strain": nodal(lv.plastic[:, None])[:, 0],
+                                  "stable": np.full(len(base.points), float(lv.stable))}})
+    last = next((lv for lv in reversed(levels) if lv.stable and lv.srf == stable), None)
+    if last is not None:
+        base.u = last.state[0].reshape(-1, 2)
+        base.stress = nodal(last.state[1][:, :3])
+        base.fields = {"plastic_strain": nodal(last.plastic[:, None])[:, 0]}
+    base.history = [lv.record() for lv in levels]
+    base.series = series
+    base.outcome = {"factor_of_safety": {"stable": stable, "failed": failed, "criterion": CRITERION,
+                                         "mode": "sweep" if settings.values else "search"}}
+    base.counts.update(levels=len(levels), newton_iterations=sum(lv.iterations for lv in levels),
+                       cutbacks=sum(lv.cutbacks for lv in levels), tangents=system.tangents)
+    base.timings = {**base.timings, "strength_reduction": seconds,
+                    "total": base.timings.get("total", 0.0) + seconds}
+    return base
