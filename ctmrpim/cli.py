@@ -65,6 +65,14 @@ def describe(result: Result, case: Case) -> str:
                          f"(stable, failed by {fos['criterion'].split(':')[0]})")
         else:
             lines.append(f"  factor of safety not bracketed: stable up to {fos['stable']}, failed from {fos['failed']}")
+    limit = result.outcome.get("limit_pressure")
+    if limit is not None:
+        if limit["failed"] is None:
+            lines.append(f"  the full load was carried (peak traction {limit['carried']:.6g}): no limit load below it")
+        else:
+            lines.append(f"  limit load: carried {limit['carried']:.6g}, not carried {limit['failed']:.6g} (peak traction; "
+                         f"load factor {result.outcome['limit_load_factor']['carried']:.5g} .. "
+                         f"{result.outcome['limit_load_factor']['failed']:.5g})")
     if "load_increments" in c:
         line = (f"  {c['load_increments']} load increments, {c['newton_iterations']} Newton iterations, "
                 f"{c['cutbacks']} cut-back(s)")

@@ -181,64 +181,103 @@ def ctm_plastic_system(case: Case, timer: Timer):
     return system, conf
 
 
-def _counts(system: PlasticSystem, sf) -> dict[str, Any]:
-    sizes = sf.support_sizes
-    return {"nodes": sf.N.shape[1], "integration_points": len(system.w),
-            "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}}
+def limit_load(path: LoadPath, peak_traction: float) -> dict[str, Any]:
+    """The limit load of a run ``until_failure``: the last load factor carried and the one that was not
+    (None if the full load was carried), and the same as the peak traction on the loaded boundary (the
+    limit pressure of a uniformly loaded footing)."""
+    carried = max((h["load_factor"] for h in path.history if h["converged"]), default=0.0)
+    failed = path.failed_at
+    return {"limit_load_factor": {"carried": carried, "failed": failed},
+            "limit_pressure": {"carried": carried * peak_traction,
+                               "failed": None if failed is None else failed * peak_traction}}
 
 
-def _parameters(case: Case, conf) -> dict[str, Any]:
+@dataclass
+class PlasticOutput:
+    """How a discretisation reports a :class:`PlasticSystem`'s state (CTM-RPIM nodes or mesh vertices)."""
+
+    method: str
+    points: np.ndarray                                          # (n, 2) output points
+    cells: list
+    displacement: Callable[[np.ndarray], np.ndarray]            # U -> (n, 2) at the points
+    nodal: Callable[[np.ndarray], np.ndarray]                   # (m, k) at the integration points -> (n, k)
+    probe_values: Callable[[np.ndarray, np.ndarray], dict]      # (U, stress (m, 3)) -> {name: probe record}
+    peak_traction: float                                        # largest traction magnitude at full load
+    counts: dict[str, Any]
+    parameters: dict[str, Any]
+
+
+def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, timer: Timer,
+                      progress: Callable[[Any], None] = lambda level: None) -> Result:
+    """Load-stepped solve of a quasi-static Mohr-Coulomb Case (gravity ramped with the load factor; with
+    ``loading.until_failure`` up to the limit load), or its strength reduction (``progress`` gets each
+    level), on any discretisation."""
     material = case.problem.material
-    return {**case.resolved, "derived": {"d_c": conf.disc.d_c, "G": material.G, "K": material.K}}
+    series: list[dict] = []
+
+    def plastic_field() -> dict[str, np.ndarray]:
+        return {"plastic_strain": out.nodal(equivalent_plastic_strain(system.plastic_strain)[:, None])[:, 0]}
+
+    def on_converged(factor: float, U: np.ndarray) -> dict:
+        series.append({"load_factor": factor, "u": out.displacement(U), "stress": out.nodal(system.stress[:, :3]),
+                       "fields": plastic_field()})
+        record = {"plastic_points": int((system.region != ELASTIC).sum())}
+        for name, rec in out.probe_values(U, None).items():
+            record[name] = {k: rec[k] for k in ("x", "y", "ux", "uy")}
+        return record
+
+    if case.problem.analysis == "strength-reduction":
+        from .strength_reduction import solve_strength_reduction
+        n = len(out.points)
+        base = Result(method=out.method, points=out.points, u=np.zeros((n, 2)), stress=np.zeros((n, 3)),
+                      cells=out.cells, counts=dict(out.counts), timings=timer.total(), parameters=out.parameters,
+                      defaults=case.defaults)
+        return solve_strength_reduction(case, system, out, base, progress)
+    path = system.run(case.loading, lambda t: material, lambda t: t, on_converged,
+                      stop_on_failure=case.loading.until_failure)
+    timer.lap("solve")
+    probes = out.probe_values(path.U, system.stress[:, :3])
+    stress = out.nodal(system.stress[:, :3])
+    fields = plastic_field()
+    timer.lap("postprocess")
+    counts = {**out.counts, "load_increments": sum(h["converged"] for h in path.history),
+              "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
+              "tangents": system.tangents, "plastic_points": int((system.region != ELASTIC).sum())}
+    return Result(
+        method=out.method, points=out.points, u=out.displacement(path.U), stress=stress, cells=out.cells,
+        probes=probes, errors={}, counts=counts, timings=timer.total(), history=path.history, series=series,
+        outcome=limit_load(path, out.peak_traction) if case.loading.until_failure else {},
+        fields=fields, parameters=out.parameters, defaults=case.defaults)
 
 
 def solve_elastoplastic(case: Case, progress: Callable[[Any], None] = lambda level: None) -> Result:
-    """Load-stepped Newton solve of a quasi-static Mohr-Coulomb Case at small strain (gravity ramped
-    with the load factor), or its strength reduction (``progress`` then gets each level)."""
+    """:func:`run_elastoplastic` with CTM-RPIM."""
     problem = case.problem
-    material = problem.material
     timer = Timer()
     system, conf = ctm_plastic_system(case, timer)
     nodes, sf = conf.disc.nodes, conf.sf
     probe_xy = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
     sf_p = shape_functions(nodes, probe_xy, derivatives=False, **conf.rpim) if len(probe_xy) else None
     timer.lap("assembly")
-    series: list[dict] = []
 
     def nodal(values: np.ndarray) -> np.ndarray:
         from .state_transfer import project_to_nodes
         return project_to_nodes(sf.N, system.w, values)
 
-    def on_converged(factor: float, U: np.ndarray) -> dict:
-        u = U.reshape(-1, 2)
-        series.append({"load_factor": factor, "u": u.copy(), "stress": nodal(system.stress[:, :3])})
-        out = {"plastic_points": int((system.region != ELASTIC).sum())}
-        if sf_p is not None:
-            up = sf_p.N @ u
-            out.update({p.name: {"x": p.x, "y": p.y, "ux": float(up[i, 0]), "uy": float(up[i, 1])}
-                        for i, p in enumerate(problem.probes)})
-        return out
+    def probe_values(U: np.ndarray, stress: np.ndarray | None) -> dict:
+        if sf_p is None:
+            return {}
+        up = sf_p.N @ U.reshape(-1, 2)
+        sp_ = sf_p.N @ nodal(stress) if stress is not None else np.full((len(up), 3), np.nan)
+        return {p.name: probe_record(p.x, p.y, up[i], sp_[i]) for i, p in enumerate(problem.probes)}
 
-    if problem.analysis == "strength-reduction":
-        from .strength_reduction import solve_strength_reduction
-        base = Result(method="ctm-rpim-mc", points=nodes, u=np.zeros((len(nodes), 2)), stress=np.zeros((len(nodes), 3)),
-                      cells=[("line", conf.disc.boundary.edges)], counts=_counts(system, sf),
-                      timings=timer.total(), parameters=_parameters(case, conf), defaults=case.defaults)
-        return solve_strength_reduction(case, system, nodal, base, progress)
-    path = system.run(case.loading, lambda t: material, lambda t: t, on_converged)
-    timer.lap("solve")
-    u = path.U.reshape(-1, 2)
-    stress_nodes = nodal(system.stress[:, :3])
-    probes = {}
-    if sf_p is not None:
-        up, sp_ = sf_p.N @ u, sf_p.N @ stress_nodes
-        probes = {p.name: probe_record(p.x, p.y, up[i], sp_[i]) for i, p in enumerate(problem.probes)}
-    timer.lap("postprocess")
-    counts = {**_counts(system, sf), "load_increments": sum(h["converged"] for h in path.history),
-              "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
-              "tangents": system.tangents, "plastic_points": int((system.region != ELASTIC).sum())}
-    return Result(
-        method="ctm-rpim-mc", points=nodes, u=u, stress=stress_nodes, cells=[("line", conf.disc.boundary.edges)],
-        probes=probes, errors={}, counts=counts, timings=timer.total(), history=path.history, series=series,
-        fields={"plastic_strain": nodal(equivalent_plastic_strain(system.plastic_strain)[:, None])[:, 0]},
-        parameters=_parameters(case, conf), defaults=case.defaults)
+    sizes = sf.support_sizes
+    material = problem.material
+    out = PlasticOutput(
+        method="ctm-rpim-mc", points=nodes, cells=[("line", conf.disc.boundary.edges)],
+        displacement=lambda U: U.reshape(-1, 2).copy(), nodal=nodal, probe_values=probe_values,
+        peak_traction=float(np.hypot(conf.tx, conf.ty).max(initial=0.0)),
+        counts={"nodes": len(nodes), "integration_points": len(system.w),
+                "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},
+        parameters={**case.resolved, "derived": {"d_c": conf.disc.d_c, "G": material.G, "K": material.K}})
+    return run_elastoplastic(case, system, out, timer, progress)

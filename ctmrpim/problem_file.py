@@ -41,7 +41,7 @@ SECTIONS: dict[str, set[str] | None] = {
     "probe": {"name", "at"},
     "point_load": {"at", "fx", "fy"},
     "exact": {"ux", "uy", "sxx", "syy", "sxy"},
-    "loading": {"steps", "tolerance", "max_iterations", "max_cutbacks", "tangent"},
+    "loading": {"steps", "tolerance", "max_iterations", "max_cutbacks", "tangent", "until_failure"},
     "strength-reduction": {"solver", "start", "step", "width", "max_srf", "steps", "values"},
 }
 LIST_SECTIONS = {"constraint", "traction", "pressure", "probe", "point_load"}
@@ -67,8 +67,12 @@ class Loading:
     max_iterations: int = 25       # Newton iterations per increment before a cut-back
     max_cutbacks: int = 8          # increment halvings before the solve gives up
     tangent: str = "consistent"    # Newton's matrix; "elastic" (Mohr-Coulomb only): see ctmrpim.elastoplastic
+    until_failure: bool = False    # Mohr-Coulomb: a load the body cannot carry ends the run with the limit
+                                   # load bracketed (no error); the limit load of a footing
 
     def __post_init__(self) -> None:
+        if not isinstance(self.until_failure, bool):
+            raise ProblemError(f"{self.until_failure!r} must be true or false", key="loading.until_failure")
         if self.tangent not in ("consistent", "elastic"):
             raise ProblemError(f"{self.tangent!r} must be \"consistent\" or \"elastic\"", key="loading.tangent")
         for key, ok in (("steps", isinstance(self.steps, int) and self.steps >= 1),
@@ -226,6 +230,9 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     if loading.tangent == "elastic" and mat["model"] != "mohr-coulomb":
         raise ProblemError("tangent = \"elastic\" is the Mohr-Coulomb solver's iteration; large-deformation "
                            "solvers use the consistent tangent", key="loading.tangent")
+    if loading.until_failure and (mat["model"] != "mohr-coulomb" or analysis != "quasi-static"):
+        raise ProblemError("until_failure needs a quasi-static Mohr-Coulomb analysis (a limit load)",
+                           key="loading.until_failure")
 
     constraints = []
     for i, c in enumerate(raw.get("constraint", [])):

@@ -16,6 +16,10 @@ def solve(case: Case, solver: str = "ctm-rpim", element: str = "q1",
     ``progress`` gets each strength-reduction level as it finishes."""
     progress = progress or (lambda level: None)
     if solver == "fem":
+        from .mohr_coulomb import MohrCoulomb
+        if isinstance(case.problem.material, MohrCoulomb):
+            from reference_fem.elastoplastic import solve_fem_elastoplastic
+            return solve_fem_elastoplastic(case, element, progress)
         if case.problem.analysis == "quasi-static":
             from reference_fem.hyperelastic import solve_fem_hyperelastic
             return solve_fem_hyperelastic(case, element)

@@ -188,12 +188,12 @@ def bracket(levels: list[Level]) -> tuple[float | None, float | None]:
     return stable, failed
 
 
-def solve_strength_reduction(case, system, nodal: Callable[[np.ndarray], np.ndarray], base: Result,
+def solve_strength_reduction(case, system, out, base: Result,
                              progress: Callable[[Level], None] = lambda level: None) -> Result:
-    """Run the ``[strength-reduction]`` of ``case`` on ``system`` (any discretisation) and fill
-    ``base`` (points, cells, counts, parameters of that discretisation) with the last stable state,
-    the levels in the history and the series, and the factor of safety as a bracket.
-    ``nodal(values at the points) -> values at base.points`` projects point values for output."""
+    """Run the ``[strength-reduction]`` of ``case`` on ``system`` (any discretisation, reported through
+    ``out``, a :class:`ctmrpim.elastoplastic.PlasticOutput`) and fill ``base`` with the last stable
+    state, the levels in the history and the series, and the factor of safety as a bracket."""
+    nodal = out.nodal
     settings: StrengthReduction = case.strength_reduction
     material = case.problem.material
     t0 = time.perf_counter()
@@ -206,13 +206,14 @@ def solve_strength_reduction(case, system, nodal: Callable[[np.ndarray], np.ndar
     series = []
     for lv in levels:
         U = lv.state[0] if lv.stable else lv.trial
-        series.append({"time": lv.srf, "load_factor": 1.0, "u": U.reshape(-1, 2), "stress": nodal(lv.stress[:, :3]),
+        series.append({"time": lv.srf, "load_factor": 1.0, "u": out.displacement(U), "stress": nodal(lv.stress[:, :3]),
                        "fields": {"plastic_strain": nodal(lv.plastic[:, None])[:, 0],
                                   "stable": np.full(len(base.points), float(lv.stable))}})
     last = next((lv for lv in reversed(levels) if lv.stable and lv.srf == stable), None)
     if last is not None:
-        base.u = last.state[0].reshape(-1, 2)
+        base.u = out.displacement(last.state[0])
         base.stress = nodal(last.state[1][:, :3])
+        base.probes = out.probe_values(last.state[0], last.state[1][:, :3])
         base.fields = {"plastic_strain": nodal(last.plastic[:, None])[:, 0]}
     base.history = [lv.record() for lv in levels]
     base.series = series
