@@ -1,0 +1,157 @@
+"""Strength reduction and limit load (issue 5): the slopes' factor of safety against Bishop's simplified
+method and the footing's limit pressure against Prandtl, with CTM-RPIM and with the scikit-fem P2
+reference on the same Problem and the same PlasticSystem, plus the pieces they are built from."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from verify import check
+
+from ctmrpim import benchmarks
+from ctmrpim.elastoplastic import block_rows, ctm_plastic_system
+from ctmrpim.errors import ProblemError
+from ctmrpim.linear_static import Timer
+from ctmrpim.load_stepping import Anderson
+from ctmrpim.mohr_coulomb import MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
+from ctmrpim.solvers import solve
+from ctmrpim.strength_reduction import StrengthReduction, bracket, reduced
+
+BISHOP = {"slope": 1.368, "slope-gl": 1.378}
+PRANDTL = (2.0 + math.pi) * 100e3
+
+
+@pytest.fixture(scope="module")
+def results() -> dict:
+    return {}
+
+
+def _solved(results: dict, name: str, solver: str):
+    if (name, solver) not in results:
+        results[name, solver] = solve(benchmarks.load(name), solver, "p2")
+    return results[name, solver]
+
+
+@pytest.mark.parametrize("name", ["slope", "slope-gl"])
+@pytest.mark.parametrize("solver, tag", [("ctm-rpim", "ctmrpim"), ("fem", "fem-p2")])
+def test_factor_of_safety_bracket_against_bishop(results, name: str, solver: str, tag: str) -> None:
+    r = _solved(results, name, solver)
+    fos = r.outcome["factor_of_safety"]
+    stable, failed = fos["stable"], fos["failed"]
+    assert stable < failed
+    check(f"{name}-{tag}-fs", max(abs(stable / BISHOP[name] - 1), abs(failed / BISHOP[name] - 1)))
+    check("slope-fs-bracket-width", failed - stable)
+    levels = r.history
+    assert levels[0]["srf"] == 1.0 and levels[0]["stable"]
+    assert all(h["stable"] for h in levels if h["srf"] <= stable)
+    assert all(not h["stable"] and h["criterion"] == "non-convergence" for h in levels if h["srf"] >= failed)
+    # the failed level's plastic zone: a band of strained points, not scattered ones
+    plastic = r.series[-1]["fields"]["plastic_strain"]
+    assert r.series[-1]["time"] == failed and np.percentile(plastic, 99) > 5 * np.median(plastic)
+
+
+@pytest.mark.parametrize("solver, tag", [("ctm-rpim", "ctmrpim"), ("fem", "fem-p2")])
+def test_footing_limit_pressure_against_prandtl(results, solver: str, tag: str) -> None:
+    r = _solved(results, "footing", solver)
+    limit = r.outcome["limit_pressure"]
+    assert limit["failed"] is not None and limit["carried"] < limit["failed"]
+    check(f"footing-{tag}-limit", max(abs(limit["carried"] / PRANDTL - 1), abs(limit["failed"] / PRANDTL - 1)))
+    # the load-displacement curve: settlement grows faster than the load towards the limit
+    carried = [h for h in r.history if h["converged"]]
+    q = np.array([h["load_factor"] for h in carried])
+    w = -np.array([h["centre"]["uy"] for h in carried])
+    assert np.all(np.diff(w[np.argsort(q)]) > 0)
+    assert w[np.argmax(q)] > 5 * w[0] * q.max() / q[0]            # far past the elastic line at the limit
+
+
+def test_sweep_mode_brackets_from_independent_levels() -> None:
+    case = benchmarks.load("slope", ["parameters.h=1.25", "strength-reduction.values=[1.1, 1.7]"])
+    r = solve(case)
+    assert [h["stable"] for h in r.history] == [True, False]
+    assert r.outcome["factor_of_safety"]["stable"] == 1.1 and r.outcome["factor_of_safety"]["failed"] == 1.7
+    assert r.outcome["factor_of_safety"]["mode"] == "sweep"
+
+
+def test_reduced_strength_follows_eqs_38_39() -> None:
+    m = MohrCoulomb(E=1e8, nu=0.3, c=1e4, phi=20.0, psi=10.0)
+    r = reduced(m, 1.6)
+    assert r.c == pytest.approx(1e4 / 1.6)
+    assert math.tan(math.radians(r.phi)) == pytest.approx(math.tan(math.radians(20.0)) / 1.6)
+    assert math.tan(math.radians(r.psi)) == pytest.approx(math.tan(math.radians(10.0)) / 1.6)
+    assert (r.E, r.nu) == (m.E, m.nu)
+
+
+def test_bracket_takes_the_largest_stable_below_the_smallest_failed() -> None:
+    from ctmrpim.strength_reduction import Level
+    levels = [Level(s, ok, 0, 0, 0.0, 0.0) for s, ok in [(1.0, True), (1.4, False), (1.3, True), (1.5, True)]]
+    assert bracket(levels) == (1.3, 1.4)
+    assert bracket(levels[:1]) == (1.0, None)
+
+
+def test_plastic_strain_is_zero_for_elastic_steps_and_isochoric_for_psi_zero() -> None:
+    m = MohrCoulomb(E=1e8, nu=0.3, c=1e4, phi=30.0, psi=0.0)
+    rng = np.random.default_rng(1)
+    stress = np.zeros((200, 4))
+    small = rng.normal(scale=1e-6, size=(200, 3))
+    s, region = m.update(stress, small)
+    assert np.all(region == 0)
+    assert np.abs(plastic_strain_increment(m, small, s - stress)).max() < 1e-18
+    large = rng.normal(scale=1e-2, size=(200, 3))
+    s, region = m.update(stress, large)
+    dp = plastic_strain_increment(m, large, s - stress)
+    main = region == 1
+    assert main.any()
+    assert np.abs(dp[main, 0] + dp[main, 1] + dp[main, 3]).max() < 1e-12       # psi = 0: no volume change
+    assert np.all(equivalent_plastic_strain(dp)[main] > 0)
+
+
+def test_anderson_solves_a_linear_fixed_point_in_n_plus_one_steps() -> None:
+    """For x -> x + P^-1 (b - A x) Anderson with full depth is GMRES: exact after n + 1 steps."""
+    rng = np.random.default_rng(0)
+    n = 6
+    A = np.eye(n) * 3 + rng.normal(scale=0.5, size=(n, n))
+    P = np.diag(np.diag(A))
+    b = rng.normal(size=n)
+    x, mixer = np.zeros(n), Anderson(n)
+    for _ in range(n + 1):
+        x = x + mixer.step(x, np.linalg.solve(P, b - A @ x), P)
+    assert np.linalg.norm(A @ x - b) < 1e-9 * np.linalg.norm(b)
+
+
+def test_block_rows_match_a_row_slice() -> None:
+    case = benchmarks.load("slope", ["parameters.h=2.5"])
+    system, _ = ctm_plastic_system(case, Timer())
+    points = np.array([0, 5, 17, 3])
+    rows = (4 * points[:, None] + np.arange(4)).ravel()
+    assert abs(block_rows(system.G, points) - sp.csr_matrix(system.G)[rows]).max() == 0
+
+
+def test_fem_gradient_operator_is_exact_for_a_linear_field() -> None:
+    from skfem import Basis, ElementTriP2, ElementVector, MeshTri
+
+    from reference_fem.elastoplastic import gradient_operator
+    basis = Basis(MeshTri().refined(2), ElementVector(ElementTriP2()), intorder=2)
+    x = basis.doflocs
+    U = np.where(np.arange(basis.N) % 2 == 0, 2 * x[0] + 3 * x[1], -x[0] + 5 * x[1])
+    grad = (gradient_operator(basis) @ U).reshape(-1, 4)
+    assert np.allclose(grad, [2, 3, -1, 5], atol=1e-12)
+
+
+@pytest.mark.parametrize("change, key", [
+    (["strength-reduction.step=0"], "strength-reduction.step"),
+    (["strength-reduction.width=0.5"], "strength-reduction.width"),
+    (['strength-reduction.solver="dynamic"'], "strength-reduction.solver"),
+    (["strength-reduction.values=1.2"], "strength-reduction.values"),
+    (['problem.analysis="quasi-static"'], "problem.analysis"),
+    (['loading.tangent="secant"'], "loading.tangent"),
+])
+def test_bad_strength_reduction_input_names_the_key(change, key: str) -> None:
+    with pytest.raises(ProblemError, match=key.replace(".", r"\.")):
+        benchmarks.load("slope", change)
+
+
+def test_until_failure_needs_a_mohr_coulomb_quasi_static_analysis() -> None:
+    with pytest.raises(ProblemError, match="until_failure"):
+        benchmarks.load("tip-load", ["loading.until_failure=true"])
