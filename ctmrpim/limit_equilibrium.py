@@ -119,3 +119,11 @@ def critical_circle(surface: np.ndarray, gamma: float, c: float, phi: float, bas
         if s is not None and s.fs < result.fs:
             result = s
     return result
+
+
+def problem_factor_of_safety(problem) -> SlipCircle:
+    """Bishop's critical circle for a slope Problem: its geometry's ground surface, unit weight
+    density x |gravity|, c and phi of its Mohr-Coulomb material, a rigid base at the bottom of the body."""
+    gamma = problem.material.density * float(np.hypot(*problem.gravity))
+    return critical_circle(top_surface(problem.geometry), gamma, problem.material.c, problem.material.phi,
+                           base=problem.geometry.bounds[1])

@@ -1,0 +1,73 @@
+"""Slope stability by strength reduction (paper Section 3.3.1, Figs. 18-20): the factor of safety of
+the two candidate geometries of Fig. 18 - `slope` (Smith & Griffiths 6.4 embankment) and `slope-gl`
+(Griffiths & Lane 1999, Example 1) - as a bracket [last stable SRF, first failed SRF], CTM-RPIM and
+scikit-fem P2 on the same nodes with the same PlasticSystem, return mapping and search (bracket by
+0.1 from SRF = 1 continuing from the last stable state, then bisection to 0.01; failure = Newton's
+non-convergence, see ctmrpim.strength_reduction), against Bishop's simplified method computed by us
+for each geometry (critical circle searched). The paper reports 1.3-1.4; Griffiths & Lane's
+finite elements 1.4. Node spacing h: the default clouds (0.58 m for `slope`, 1928 nodes, the paper's
+about 1881; 0.35 m for `slope-gl`, 1926 nodes) in the full run, beside coarser ones (1.0 m and 0.6 m,
+about 680 nodes) that show the trend with resolution; quick mode runs the coarser ones only.
+"""
+from __future__ import annotations
+
+import sys
+from functools import cache
+
+import pandas as pd
+
+from ctmrpim import benchmarks
+from ctmrpim.limit_equilibrium import problem_factor_of_safety
+from ctmrpim.sweep import CaseSpec
+
+from .base import finished, new_figure
+
+NAME = "slope_stability"
+TITLE = "Slope factor of safety by strength reduction (cf. Figs. 18-19)"
+SPACING = {"slope": {"quick": [1.0], "full": [1.0, 0.58]}, "slope-gl": {"quick": [0.6], "full": [0.6, 0.35]}}
+PAPER = (1.3, 1.4)
+
+
+@cache
+def bishop(target: str) -> float:
+    return problem_factor_of_safety(benchmarks.load(target).problem).fs
+
+
+def specs(quick: bool) -> list[CaseSpec]:
+    mode = "quick" if quick else "full"
+    return [CaseSpec(target, (f"parameters.h={h!r}",), solver, "p2", labels=(("slope", target), ("h", h)))
+            for target, hs in SPACING.items() for h in hs[mode] for solver in ("ctm-rpim", "fem")]
+
+
+def extra(summary: dict) -> dict:
+    fos = summary["factor_of_safety"]
+    target = summary["parameters"]["problem"]["name"]
+    reference = bishop(target)
+    worst = max(abs(fos["stable"] / reference - 1), abs(fos["failed"] / reference - 1))
+    return {"fs_stable": fos["stable"], "fs_failed": fos["failed"], "bishop": reference,
+            "worst_rel_diff": worst, "levels": summary["counts"]["levels"],
+            "iterations": summary["counts"]["newton_iterations"]}
+
+
+def figure(df: pd.DataFrame):
+    fig, axes = new_figure(1, 6.5)
+    ax = axes[0, 0]
+    ok = df[df.status == "ok"].reset_index(drop=True)
+    labels = []
+    for i, r in ok.iterrows():
+        colour = "tab:blue" if r.method == "ctm-rpim" else "tab:orange"
+        ax.plot([i, i], [r.fs_stable, r.fs_failed], "-", lw=6, color=colour, solid_capstyle="butt")
+        ax.plot([i - 0.35, i + 0.35], [r.bishop, r.bishop], "k-", lw=1)
+        labels.append(f"{r.slope}\n{r.method}\n{r.nodes} nodes")
+    ax.axhspan(*PAPER, color="0.9", label="paper: stable at 1.3, failed at 1.4")
+    ax.plot([], [], "-", lw=6, color="tab:blue", label="CTM-RPIM [stable, failed]")
+    ax.plot([], [], "-", lw=6, color="tab:orange", label="scikit-fem P2 [stable, failed]")
+    ax.plot([], [], "k-", label="Bishop's simplified method (ours)")
+    ax.set_xticks(range(len(labels)), labels, fontsize=7)
+    ax.set(ylabel="factor of safety (SRF)", title=TITLE, ylim=(1.25, 1.45))
+    return finished(fig, axes)
+
+
+if __name__ == "__main__":
+    from .cli import main
+    main(sys.modules[__name__])
