@@ -57,7 +57,7 @@ def describe(result: Result, case: Case) -> str:
     fos = result.outcome.get("factor_of_safety")
     if fos is not None:
         lines.append(f"  {c['levels']} strength-reduction levels ({fos['mode']}), {c['newton_iterations']} iterations, "
-                     f"{c['cutbacks']} cut-back(s), {c['tangents']} stiffness factorisation(s)")
+                     f"{c['cutbacks']} cut-back(s), {c['factorisations']} stiffness factorisation(s)")
         for h in result.history:
             lines.append("    " + _level_line(h))
         if fos["stable"] is not None and fos["failed"] is not None:
@@ -83,6 +83,8 @@ def describe(result: Result, case: Case) -> str:
         for h in result.history:
             if "note" in h:
                 lines.append(f"  note at load factor {h['load_factor']:.4g}: {h['note']}")
+    if c.get("iteration_seconds"):
+        lines.append("  of the iterations: " + ", ".join(f"{k} {v:.2f} s" for k, v in c["iteration_seconds"].items()))
     phases = ", ".join(f"{k.replace('_', ' ')} {v:.3f}" for k, v in t.items() if k != "total")
     lines.append(f"  time: {t['total']:.3f} s ({phases})")
     return "\n".join(lines)

@@ -27,6 +27,7 @@ one, with the same material class and the same iteration, chosen by ``loading.ta
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -89,7 +90,9 @@ class PlasticSystem:
     region: np.ndarray = field(init=False)
     plastic_strain: np.ndarray = field(init=False)   # (m, 4) xx, yy, xy (tensor), zz
     tangent: str = "consistent"             # "consistent" (modified Newton) or "elastic" (see the module)
-    tangents: int = 0                       # tangents built (each with its factorisation)
+    tangents: int = 0                       # tangents built
+    factorisations: int = 0                 # LU factorisations (a tangent equal to the last one reuses them)
+    seconds: dict[str, float] = field(default_factory=dict)   # time per phase of the iteration
 
     def __post_init__(self) -> None:
         self.GT = self.G.T
@@ -126,31 +129,38 @@ class PlasticSystem:
 
     def assemble(self, material: MohrCoulomb, U: np.ndarray, load_factor: float):
         """(F_ext, F_int, K) at the trial U; K is the elastic stiffness or the consistent tangent."""
+        t0 = time.perf_counter()
         de = self.strain_increment(U)
         stress, region = material.update(self.stress, de)
+        t1 = time.perf_counter()
         f_ext = self.dead(load_factor) + load_factor * self.body
         f_int = internal_force(self.G, stress[:, :3] @ TO_P.T, self.w, self.GT)
+        t2 = time.perf_counter()
         if self._K_elastic is None:   # E and nu never change (the strength reduction divides c and phi only)
             A = np.broadcast_to(TO_P @ material.D("strain") @ FROM_GRAD, (len(self.w), 4, 4))
             self._K_elastic = tangent(self.G, A, self.w, self.GT)
         if self.tangent == "elastic":
             if self._K is None:
-                self._K, self._lu = self._K_elastic, None
+                self._K = self._K_elastic
                 self.tangents += 1
         else:
             # K = K_elastic + the plastic points' correction: its product runs over those points only
             plastic = np.flatnonzero(region != ELASTIC)
-            self._K, self._lu = self._K_elastic, None
+            self._K = self._K_elastic          # its factors are kept while no point is plastic
             if len(plastic):
                 dA = TO_P[None] @ (material.tangent(self.stress[plastic], de[plastic])
                                    - material.D("strain")[None]) @ FROM_GRAD[None]
                 Gp = block_rows(self.G, plastic)
                 self._K = self._K_elastic + tangent(Gp, dA, self.w[plastic], Gp.T)
             self.tangents += 1
+        self._clock("return mapping", t1 - t0)
+        self._clock("internal force", t2 - t1)
+        self._clock("tangent", time.perf_counter() - t2)
         return f_ext, f_int, self._K
 
     def solve(self, K: sp.csr_matrix, residual: np.ndarray) -> np.ndarray:
         """du with du = 0 at the fixed dofs, reusing the LU factors of K while K is unchanged."""
+        t0 = time.perf_counter()
         if self._lu is None or self._lu[0] is not K:
             Kff = K[self.free][:, self.free].tocsc()
             try:
@@ -158,9 +168,16 @@ class PlasticSystem:
                                          options={"SymmetricMode": True}))
             except RuntimeError as exc:
                 raise ProblemError(f"the tangent stiffness is singular ({exc})") from None
+            self.factorisations += 1
+        t1 = time.perf_counter()
         du = np.zeros_like(residual)
         du[self.free] = self._lu[1].solve(residual[self.free])
+        self._clock("factorisation", t1 - t0)
+        self._clock("substitution", time.perf_counter() - t1)
         return du
+
+    def _clock(self, phase: str, seconds: float) -> None:
+        self.seconds[phase] = self.seconds.get(phase, 0.0) + seconds
 
     def run(self, loading: Loading, material_at: Callable[[float], MohrCoulomb],
             load_at: Callable[[float], float], on_converged: Callable[[float, np.ndarray], dict[str, Any]],
@@ -169,7 +186,7 @@ class PlasticSystem:
         ``material_at(t)`` and the loads are at ``load_at(t)`` times their full value (a load ramp,
         or a strength-reduction stage at constant load)."""
         if self.tangent != "elastic":
-            self._K, self._lu = None, None
+            self._K = None
 
         def assemble(U: np.ndarray, t: float):
             return self.assemble(material_at(t), U, load_at(t))
@@ -266,7 +283,9 @@ def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, tim
     timer.lap("postprocess")
     counts = {**out.counts, "load_increments": sum(h["converged"] for h in path.history),
               "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
-              "tangents": system.tangents, "plastic_points": int((system.region != ELASTIC).sum())}
+              "tangents": system.tangents, "factorisations": system.factorisations,
+              "plastic_points": int((system.region != ELASTIC).sum()),
+              "iteration_seconds": {k: round(v, 3) for k, v in system.seconds.items()}}
     return Result(
         method=out.method, points=out.points, u=out.displacement(path.U), stress=stress, cells=out.cells,
         probes=probes, errors={}, counts=counts, timings=timer.total(), history=path.history, series=series,
@@ -284,9 +303,8 @@ def solve_elastoplastic(case: Case, progress: Callable[[Any], None] = lambda lev
     sf_p = shape_functions(nodes, probe_xy, derivatives=False, **conf.rpim) if len(probe_xy) else None
     timer.lap("assembly")
 
-    def nodal(values: np.ndarray) -> np.ndarray:
-        from .state_transfer import project_to_nodes
-        return project_to_nodes(sf.N, system.w, values)
+    from .state_transfer import NodalProjection
+    nodal = NodalProjection(sf.N, system.w)
 
     def probe_values(U: np.ndarray, stress: np.ndarray | None) -> dict:
         if sf_p is None:

@@ -271,8 +271,8 @@ def _stability_section(w, tables: dict[str, pd.DataFrame], quick: bool, out_dir:
           .assign(bishop=lambda d: d.bishop.map(lambda v: f"{v:.4f}"))))
     w("\n\n![slope stability](slope_stability.png)\n\n")
     w("Measured at the default resolution (full mode, and `python benchmarks/bench_stability.py`): `slope` "
-      "CTM-RPIM [1.3406, 1.3422], P2 [1.3375, 1.3438]; `slope-gl` CTM-RPIM [1.3438, 1.3469], P2 [1.3375, 1.3406]: "
-      "both methods agree within 0.005 and lie 2-2.5 % below Bishop's simplified method (1.368, 1.378), inside "
+      "CTM-RPIM [1.3406, 1.3422] in 24 s, P2 [1.3406, 1.3438] in 14 s; `slope-gl` CTM-RPIM [1.3438, 1.3469] in "
+      "27 s, P2 [1.3438, 1.3469] in 12 s: both methods agree within 0.003 and lie 2-2.5 % below Bishop's simplified method (1.368, 1.378), inside "
       "the paper's [1.3, 1.4] and below Griffiths & Lane's finite-element 1.4. The coarser clouds give 0.5-1 % "
       "more. The bracket is that of a numerical criterion: Newton's non-convergence within 100 iterations at a "
       "tolerance of 1e-4 after four halvings of the SRF step; with 300 iterations it moves up by about 0.004, "

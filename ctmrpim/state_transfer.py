@@ -19,16 +19,27 @@ from scipy.sparse.linalg import splu
 from .errors import ProblemError
 
 
+class NodalProjection:
+    """The L2 projection onto the nodal RPIM space from points with shape-function rows ``N`` (m, n)
+    and quadrature weights (m,): the mass matrix is factorised once, each call is one solve."""
+
+    def __init__(self, N: sp.csr_matrix, weights: np.ndarray) -> None:
+        self.N, self.weights = N, weights
+        try:
+            self.lu = splu((N.T @ sp.diags(weights) @ N).tocsc())
+        except RuntimeError:
+            raise ProblemError("state transfer: the projection's mass matrix is singular (a node has no "
+                               "integration point in its support)") from None
+
+    def __call__(self, values: np.ndarray) -> np.ndarray:
+        """Nodal values (n, k) of ``values`` (m, k) given at the points."""
+        return self.lu.solve(np.asarray(self.N.T @ (values * self.weights[:, None])))
+
+
 def project_to_nodes(N: sp.csr_matrix, weights: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Nodal values (n, k) of the L2 projection of ``values`` (m, k) given at points with shape-function
     rows ``N`` (m, n) and quadrature weights ``weights`` (m,)."""
-    M = (N.T @ sp.diags(weights) @ N).tocsc()
-    rhs = N.T @ (values * weights[:, None])
-    try:
-        return splu(M).solve(np.asarray(rhs))
-    except RuntimeError:
-        raise ProblemError("state transfer: the projection's mass matrix is singular (a node has no "
-                           "integration point in its support)") from None
+    return NodalProjection(N, weights)(values)
 
 
 def transfer(N_old: sp.csr_matrix, w_old: np.ndarray, values: np.ndarray, N_new: sp.csr_matrix

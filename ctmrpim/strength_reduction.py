@@ -220,7 +220,9 @@ def solve_strength_reduction(case, system, out, base: Result,
     base.outcome = {"factor_of_safety": {"stable": stable, "failed": failed, "criterion": CRITERION,
                                          "mode": "sweep" if settings.values else "search"}}
     base.counts.update(levels=len(levels), newton_iterations=sum(lv.iterations for lv in levels),
-                       cutbacks=sum(lv.cutbacks for lv in levels), tangents=system.tangents)
+                       cutbacks=sum(lv.cutbacks for lv in levels), tangents=system.tangents,
+                       factorisations=system.factorisations,
+                       iteration_seconds={k: round(v, 3) for k, v in system.seconds.items()})
     base.timings = {**base.timings, "strength_reduction": seconds,
                     "total": base.timings.get("total", 0.0) + seconds}
     return base
