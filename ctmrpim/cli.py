@@ -65,6 +65,10 @@ def describe(result: Result, case: Case) -> str:
                          f"(stable, failed by {fos['criterion'].split(':')[0]})")
         else:
             lines.append(f"  factor of safety not bracketed: stable up to {fos['stable']}, failed from {fos['failed']}")
+    relaxed = result.outcome.get("relaxation")
+    if relaxed is not None:
+        lines.append(f"  dynamic relaxation: {'at rest' if relaxed['at_rest'] else 'NOT at rest'} after {relaxed['steps']} "
+                     f"steps (out-of-balance force {relaxed['residual']:.2e} of the loads)")
     limit = result.outcome.get("limit_pressure")
     if limit is not None:
         if limit["failed"] is None:
@@ -92,10 +96,11 @@ def describe(result: Result, case: Case) -> str:
 
 def _level_line(h: dict) -> str:
     state = "stable" if h["stable"] else "FAILED"
-    if "criterion" in h:
+    if h.get("criterion"):
         state += f" ({h['criterion']})"
-    return (f"SRF {h['srf']:.4f}: {state}, {h['iterations']} iterations, {h['cutbacks']} cut-back(s), "
-            f"max |u| {h['max_displacement']:.4g}, {h['seconds']:.1f} s")
+    work = (f"{h['iterations']} relaxation steps" if "displacement_history" in h
+            else f"{h['iterations']} iterations, {h['cutbacks']} cut-back(s)")
+    return f"SRF {h['srf']:.4f}: {state}, {work}, max |u| {h['max_displacement']:.4g}, {h['seconds']:.1f} s"
 
 
 def cmd_list(args: argparse.Namespace) -> int:

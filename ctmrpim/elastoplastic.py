@@ -85,6 +85,7 @@ class PlasticSystem:
     fixed_values: np.ndarray
     dead: Callable[[float], np.ndarray]     # load factor -> F of the tractions and point loads
     body: np.ndarray                        # gravity at full value
+    material: MohrCoulomb                   # its E and nu give the elastic stiffness
     U: np.ndarray = field(init=False)
     stress: np.ndarray = field(init=False)
     region: np.ndarray = field(init=False)
@@ -117,6 +118,17 @@ class PlasticSystem:
         self.plastic_strain += plastic_strain_increment(material, de, stress - self.stress)
         self.stress, self.U = stress, U.copy()
 
+    def external_force(self, load_factor: float) -> np.ndarray:
+        return self.dead(load_factor) + load_factor * self.body
+
+    def elastic_stiffness(self, material: MohrCoulomb | None = None) -> sp.csr_matrix:
+        """The elastic stiffness (built on first use; E and nu never change)."""
+        if self._K_elastic is None:
+            D = (material or self.material).D("strain")
+            A = np.broadcast_to(TO_P @ D @ FROM_GRAD, (len(self.w), 4, 4))
+            self._K_elastic = tangent(self.G, A, self.w, self.GT)
+        return self._K_elastic
+
     def internal_force(self) -> np.ndarray:
         """G^T (w sigma) of the committed stress (with the reactions at the fixed dofs)."""
         return internal_force(self.G, self.stress[:, :3] @ TO_P.T, self.w, self.GT)
@@ -133,12 +145,10 @@ class PlasticSystem:
         de = self.strain_increment(U)
         stress, region = material.update(self.stress, de)
         t1 = time.perf_counter()
-        f_ext = self.dead(load_factor) + load_factor * self.body
+        f_ext = self.external_force(load_factor)
         f_int = internal_force(self.G, stress[:, :3] @ TO_P.T, self.w, self.GT)
         t2 = time.perf_counter()
-        if self._K_elastic is None:   # E and nu never change (the strength reduction divides c and phi only)
-            A = np.broadcast_to(TO_P @ material.D("strain") @ FROM_GRAD, (len(self.w), 4, 4))
-            self._K_elastic = tangent(self.G, A, self.w, self.GT)
+        self.elastic_stiffness(material)   # E and nu never change (the strength reduction divides c and phi only)
         if self.tangent == "elastic":
             if self._K is None:
                 self._K = self._K_elastic
@@ -218,7 +228,8 @@ def ctm_plastic_system(case: Case, timer: Timer):
                           problem.thickness * assembly.point_load_vector(nodes, problem, conf.rpim))
     system = PlasticSystem(gradient_operator(sf.dNdx, sf.dNdy), w, conf.fixed, conf.fixed_values,
                            lambda factor: loads.forces(nodes, factor)[0],
-                           assembly.body_force_vector(sf.N, w, problem), tangent=case.loading.tangent)
+                           assembly.body_force_vector(sf.N, w, problem), problem.material,
+                           tangent=case.loading.tangent)
     return system, conf
 
 
@@ -274,6 +285,8 @@ def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, tim
                       cells=out.cells, counts=dict(out.counts), timings=timer.total(), parameters=out.parameters,
                       defaults=case.defaults)
         return solve_strength_reduction(case, system, out, base, progress)
+    if case.problem.analysis == "dynamic":
+        return _relaxed(case, system, out, timer)
     path = system.run(case.loading, lambda t: material, lambda t: t, on_converged,
                       stop_on_failure=case.loading.until_failure)
     timer.lap("solve")
@@ -291,6 +304,25 @@ def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, tim
         probes=probes, errors={}, counts=counts, timings=timer.total(), history=path.history, series=series,
         outcome=limit_load(path, out.peak_traction) if case.loading.until_failure else {},
         fields=fields, parameters=out.parameters, defaults=case.defaults)
+
+
+def _relaxed(case: Case, system: PlasticSystem, out: PlasticOutput, timer: Timer) -> Result:
+    """Dynamic relaxation of the loads applied at once (``analysis = "dynamic"``)."""
+    from .dynamic_relaxation import relax
+    path = relax(system, case.problem.material, 1.0, case.relaxation)
+    timer.lap("solve")
+    stress = system.stress[:, :3]
+    result = Result(
+        method=out.method, points=out.points, u=out.displacement(system.U), stress=out.nodal(stress), cells=out.cells,
+        probes=out.probe_values(system.U, stress), errors={},
+        counts={**out.counts, "steps": path.steps, "plastic_points": int((system.region != ELASTIC).sum())},
+        timings={}, history=path.history,
+        fields={"plastic_strain": out.nodal(equivalent_plastic_strain(system.plastic_strain)[:, None])[:, 0]},
+        outcome={"relaxation": {"at_rest": path.at_rest, "steps": path.steps, "residual": path.residual}},
+        parameters=out.parameters, defaults=case.defaults)
+    timer.lap("postprocess")
+    result.timings = timer.total()
+    return result
 
 
 def solve_elastoplastic(case: Case, progress: Callable[[Any], None] = lambda level: None) -> Result:

@@ -25,6 +25,7 @@ from .material import LinearElastic
 from .mohr_coulomb import MohrCoulomb
 from .method import Method
 from .nodes import NodeSpec
+from .dynamic_relaxation import Relaxation
 from .strength_reduction import StrengthReduction
 from .problem import Constraint, ExactSolution, PointLoad, Pressure, Probe, Problem, Traction
 
@@ -43,6 +44,7 @@ SECTIONS: dict[str, set[str] | None] = {
     "exact": {"ux", "uy", "sxx", "syy", "sxy"},
     "loading": {"steps", "tolerance", "max_iterations", "max_cutbacks", "tangent", "until_failure"},
     "strength-reduction": {"solver", "start", "step", "width", "max_srf", "steps", "values"},
+    "dynamic": {"steps", "damping", "tolerance", "record_every"},
 }
 LIST_SECTIONS = {"constraint", "traction", "pressure", "probe", "point_load"}
 REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E", "nu"],
@@ -51,11 +53,11 @@ REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E",
 #: Names people reach for instead of the file's keys, to suggest where difflib finds no close spelling.
 SYNONYMS = {"youngs": "E", "young": "E", "youngs_modulus": "E", "young_modulus": "E", "modulus": "E",
             "poisson": "nu", "poissons_ratio": "nu", "poisson_ratio": "nu", "rho": "density"}
-ANALYSES = ("linear", "quasi-static", "strength-reduction")
+ANALYSES = ("linear", "quasi-static", "strength-reduction", "dynamic")
 MATERIAL_MODELS = ("linear-elastic", "neo-hookean", "mohr-coulomb")
 #: the material models each analysis solves (quasi-static linear-elastic: the updated-Lagrangian rate form)
 ANALYSIS_MODELS = {"linear": ("linear-elastic",), "quasi-static": ("neo-hookean", "linear-elastic", "mohr-coulomb"),
-                   "strength-reduction": ("mohr-coulomb",)}
+                   "strength-reduction": ("mohr-coulomb",), "dynamic": ("mohr-coulomb",)}
 
 
 @dataclass(frozen=True)
@@ -96,6 +98,7 @@ class Case:
     defaults: list[str] = field(default_factory=list)
     loading: Loading = field(default_factory=Loading)
     strength_reduction: StrengthReduction | None = None
+    relaxation: Relaxation | None = None          # [dynamic]: dynamic relaxation settings
 
 
 def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
@@ -227,6 +230,21 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
                 v = num(v, f"strength-reduction.{key}")
             sr[key] = v
         strength_reduction = StrengthReduction(**sr)
+    dyn_raw = raw.get("dynamic")
+    uses_relaxation = analysis == "dynamic" or (strength_reduction is not None
+                                                and strength_reduction.solver == "dynamic-relaxation")
+    if dyn_raw is not None and not uses_relaxation:
+        raise ProblemError("[dynamic] needs analysis = \"dynamic\" or strength-reduction.solver = "
+                           "\"dynamic-relaxation\"", key="dynamic")
+    relaxation = None
+    if uses_relaxation:
+        dyn = {}
+        for key, spec in Relaxation.__dataclass_fields__.items():
+            if key not in (dyn_raw or {}):
+                defaults.append(f"dynamic.{key} = {spec.default!r}")
+                continue
+            dyn[key] = num(dyn_raw[key], f"dynamic.{key}") if key in ("damping", "tolerance") else dyn_raw[key]
+        relaxation = Relaxation(**dyn)
     if loading.tangent == "elastic" and mat["model"] != "mohr-coulomb":
         raise ProblemError("tangent = \"elastic\" is the Mohr-Coulomb solver's iteration; large-deformation "
                            "solvers use the consistent tangent", key="loading.tangent")
@@ -347,10 +365,13 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     }
     if analysis in ("quasi-static", "strength-reduction"):
         resolved["loading"] = asdict(loading)
+    if relaxation is not None:
+        resolved["dynamic"] = asdict(relaxation)
     if strength_reduction is not None:
         resolved["strength-reduction"] = {**asdict(strength_reduction), "values": list(strength_reduction.values)}
     return Case(problem=problem, nodes=nodes, method=method, source=source, base_dir=base_dir,
-                resolved=resolved, defaults=defaults, loading=loading, strength_reduction=strength_reduction)
+                resolved=resolved, defaults=defaults, loading=loading, strength_reduction=strength_reduction,
+                relaxation=relaxation)
 
 
 def _grid(value: Any, num) -> tuple[int, int]:

@@ -25,7 +25,7 @@ def solve(case: Case, solver: str = "ctm-rpim", element: str = "q1",
             return solve_fem_hyperelastic(case, element)
         from reference_fem import solve_fem
         return solve_fem(case, element)
-    if case.problem.analysis == "strength-reduction":
+    if case.problem.analysis in ("strength-reduction", "dynamic"):
         from .elastoplastic import solve_elastoplastic
         return solve_elastoplastic(case, progress)
     if case.problem.analysis == "quasi-static":

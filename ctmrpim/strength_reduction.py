@@ -29,13 +29,21 @@ from typing import Any, Callable
 
 import numpy as np
 
+from .dynamic_relaxation import Relaxation, relax
 from .errors import ProblemError
 from .mohr_coulomb import MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
 from .result import Result
 
-SOLVERS = ("newton",)
-CRITERION = ("non-convergence: Newton did not reach the residual and displacement tolerance within "
-             "loading.max_iterations iterations at an SRF sub-step cut back loading.max_cutbacks times")
+SOLVERS = ("newton", "dynamic-relaxation")
+CRITERION = {"newton": "non-convergence: Newton did not reach the residual and displacement tolerance within "
+                       "loading.max_iterations iterations at an SRF sub-step cut back loading.max_cutbacks times",
+             "dynamic-relaxation": "still moving: after dynamic.steps steps of dynamic relaxation the out-of-balance "
+                                   "force is above dynamic.tolerance of the loads and the maximum displacement grew "
+                                   "by more than 1 % over the last quarter of the steps (the paper's criterion: it "
+                                   "keeps growing)"}
+#: Dynamic relaxation: a level not at rest whose maximum displacement grew by at most this fraction over
+#: the last quarter of its steps has settled (a slowly creeping stable level is not a failure).
+SETTLED_GROWTH = 0.01
 
 
 @dataclass(frozen=True)
@@ -86,11 +94,31 @@ class Level:
     trial: np.ndarray | None = None                # last iterate of a failed level
     plastic: np.ndarray | None = None              # equivalent plastic strain at the points (failed: last iterate)
     stress: np.ndarray | None = None               # stress (m, 4) at the points (failed: last iterate)
+    path: list[list[float]] | None = None          # dynamic relaxation: [step, max displacement] as it ran
 
     def record(self) -> dict[str, Any]:
         return {"srf": self.srf, "stable": self.stable, "iterations": self.iterations, "cutbacks": self.cutbacks,
                 "max_displacement": self.max_displacement, "seconds": round(self.seconds, 3),
-                **({"criterion": self.criterion} if self.criterion else {})}
+                **({"criterion": self.criterion} if self.criterion else {}),
+                **({"displacement_history": self.path} if self.path is not None else {})}
+
+
+def _relax_level(system, relaxation: Relaxation, material: MohrCoulomb, srf: float, fixed_values=None) -> Level:
+    """Dynamic relaxation from the committed state with ``material`` under the full loads."""
+    t0 = time.perf_counter()
+    path = relax(system, material, 1.0, relaxation, fixed_values)
+    common = dict(plastic=equivalent_plastic_strain(system.plastic_strain), stress=system.stress.copy(),
+                  path=[[h["step"], h["max_displacement"]] for h in path.history])
+    seconds = time.perf_counter() - t0
+    growth = path.growth()
+    if path.at_rest or growth <= SETTLED_GROWTH:
+        note = "" if path.at_rest else (f"not at rest (out-of-balance {path.residual:.1e}) but settled: the "
+                                        f"displacement grew {100 * growth:.2g} % over the last quarter of the steps")
+        return Level(srf, True, path.steps, 0, _max_displacement(system.U), seconds, criterion=note,
+                     state=system.snapshot(), **common)
+    return Level(srf, False, path.steps, 0, _max_displacement(system.U), seconds,
+                 criterion=f"not at rest, still moving ({100 * growth:.2g} % over the last quarter)",
+                 trial=system.U.copy(), **common)
 
 
 def _max_displacement(U: np.ndarray) -> float:
@@ -125,17 +153,21 @@ def _level(system, loading, material_at, load_at, srf_at: Callable[[float], floa
                          plastic=equivalent_plastic_strain(system.plastic_strain), stress=system.stress.copy())
 
 
-def gravity_level(system, loading, material: MohrCoulomb, srf: float) -> Level:
-    """Loads ramped from zero on the reduced material (the first stage of a search; one sweep level)."""
+def gravity_level(system, loading, material: MohrCoulomb, srf: float, relaxation: Relaxation | None = None) -> Level:
+    """Loads ramped from zero on the reduced material (the first stage of a search; one sweep level);
+    with ``relaxation``, applied at once and relaxed (the paper's way)."""
     m = reduced(material, srf)
+    if relaxation is not None:
+        return _relax_level(system, relaxation, m, srf)
     return _level(system, loading, lambda t: m, lambda t: t, lambda t: srf)[0]
 
 
 def search(system, loading, material: MohrCoulomb, settings: StrengthReduction,
-           progress: Callable[[Level], None] = lambda level: None) -> tuple[list[Level], Level, Level]:
+           progress: Callable[[Level], None] = lambda level: None,
+           relaxation: Relaxation | None = None) -> tuple[list[Level], Level, Level]:
     """Bracket and bisect the factor of safety; returns (levels in order, last stable, first failed
     of the final bracket). The system is left in the last stable state."""
-    first = gravity_level(system, loading, material, settings.start)
+    first = gravity_level(system, loading, material, settings.start, relaxation)
     progress(first)
     levels = [first]
     if not first.stable:
@@ -152,8 +184,11 @@ def search(system, loading, material: MohrCoulomb, settings: StrengthReduction,
         system.restore(stable.state)
         s0 = stable.srf
         srf_at = lambda t, s0=s0, s1=target: s0 + t * (s1 - s0)   # noqa: E731
-        level, reached = _level(system, level_loading, lambda t: reduced(material, srf_at(t)), lambda t: 1.0, srf_at,
-                                fixed_values)
+        if relaxation is not None:     # the strength reduced at once, relaxed from the stable state
+            level, reached = _relax_level(system, relaxation, reduced(material, target), target, fixed_values), None
+        else:
+            level, reached = _level(system, level_loading, lambda t: reduced(material, srf_at(t)), lambda t: 1.0,
+                                    srf_at, fixed_values)
         if reached is not None:   # the cut-back sub-steps converged part of the way: stable there
             progress(reached)
             levels.append(reached)
@@ -169,13 +204,14 @@ def search(system, loading, material: MohrCoulomb, settings: StrengthReduction,
 
 
 def sweep(system, loading, material: MohrCoulomb, values: tuple[float, ...],
-          progress: Callable[[Level], None] = lambda level: None) -> list[Level]:
-    """Each SRF on its own, gravity ramped from zero at the reduced strength."""
+          progress: Callable[[Level], None] = lambda level: None, relaxation: Relaxation | None = None
+          ) -> list[Level]:
+    """Each SRF on its own from zero, gravity at the reduced strength."""
     start = system.snapshot()
     levels = []
     for srf in values:
         system.restore(start)
-        level = gravity_level(system, loading, material, srf)
+        level = gravity_level(system, loading, material, srf, relaxation)
         progress(level)
         levels.append(level)
     return levels
@@ -196,11 +232,12 @@ def solve_strength_reduction(case, system, out, base: Result,
     nodal = out.nodal
     settings: StrengthReduction = case.strength_reduction
     material = case.problem.material
+    relaxation = case.relaxation if settings.solver == "dynamic-relaxation" else None
     t0 = time.perf_counter()
     if settings.values:
-        levels = sweep(system, case.loading, material, settings.values, progress)
+        levels = sweep(system, case.loading, material, settings.values, progress, relaxation)
     else:
-        levels, _, _ = search(system, case.loading, material, settings, progress)
+        levels, _, _ = search(system, case.loading, material, settings, progress, relaxation)
     seconds = time.perf_counter() - t0
     stable, failed = bracket(levels)
     series = []
@@ -217,7 +254,7 @@ def solve_strength_reduction(case, system, out, base: Result,
         base.fields = {"plastic_strain": nodal(last.plastic[:, None])[:, 0]}
     base.history = [lv.record() for lv in levels]
     base.series = series
-    base.outcome = {"factor_of_safety": {"stable": stable, "failed": failed, "criterion": CRITERION,
+    base.outcome = {"factor_of_safety": {"stable": stable, "failed": failed, "criterion": CRITERION[settings.solver],
                                          "mode": "sweep" if settings.values else "search"}}
     base.counts.update(levels=len(levels), newton_iterations=sum(lv.iterations for lv in levels),
                        cutbacks=sum(lv.cutbacks for lv in levels), tangents=system.tangents,

@@ -70,7 +70,7 @@ def solve_fem_elastoplastic(case: Case, element: str = "p2",
     body = thickness * LinearForm(lambda v, w_: bx * v[0] + by * v[1]).assemble(basis)
     fixed, fixed_values = _constrained_dofs(problem, fm, basis, tol)
     system = PlasticSystem(gradient_operator(basis).tobsr(blocksize=(4, 1)), w, fixed, fixed_values,
-                           lambda factor: factor * F_dead, body, tangent=case.loading.tangent)
+                           lambda factor: factor * F_dead, body, problem.material, tangent=case.loading.tangent)
     mass = splu(csc_matrix(BilinearForm(lambda u, v, w_: u * v).assemble(scalar)))
     nel, nq = basis.nelems, basis.X.shape[-1]
     vertices = scalar.nodal_dofs[0]

@@ -13,7 +13,7 @@ import pandas as pd
 
 NAMES = ["node_density", "integration_density", "support_radius", "shape_parameter", "parameter_map",
          "time_to_accuracy", "plate_hole_convergence", "tip_load", "end_moment", "slope_stability",
-         "slope_srf_sweep", "footing_bearing"]
+         "slope_srf_sweep", "slope_relaxation", "footing_bearing"]
 #: command-line spelling (dashes) -> module name
 ALIASES = {n.replace("_", "-"): n for n in NAMES}
 

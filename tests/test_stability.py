@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from scipy.sparse.linalg import spsolve
 from verify import check
 
 from ctmrpim import benchmarks
@@ -17,7 +18,7 @@ from ctmrpim.linear_static import Timer
 from ctmrpim.load_stepping import Anderson
 from ctmrpim.mohr_coulomb import MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
 from ctmrpim.solvers import solve
-from ctmrpim.strength_reduction import StrengthReduction, bracket, reduced
+from ctmrpim.strength_reduction import bracket, reduced
 
 BISHOP = {"slope": 1.368, "slope-gl": 1.378}
 PRANDTL = (2.0 + math.pi) * 100e3
@@ -155,3 +156,36 @@ def test_bad_strength_reduction_input_names_the_key(change, key: str) -> None:
 def test_until_failure_needs_a_mohr_coulomb_quasi_static_analysis() -> None:
     with pytest.raises(ProblemError, match="until_failure"):
         benchmarks.load("tip-load", ["loading.until_failure=true"])
+
+
+def test_dynamic_relaxation_comes_to_rest_at_the_elastic_solution() -> None:
+    """A strong Mohr-Coulomb column under its own weight stays elastic: relaxed to rest it matches the
+    linear solve of the same CTM-RPIM discretisation (the exact K0 column within the method's error)."""
+    from ctmrpim.dynamic_relaxation import Relaxation, relax, relaxation_mass
+    case = benchmarks.load("self-weight", ['problem.analysis="dynamic"', 'material.model="mohr-coulomb"',
+                                           "material.c=1e9", "material.phi=30"])
+    system, _ = ctm_plastic_system(case, Timer())
+    assert np.all(relaxation_mass(system) > 0)
+    path = relax(system, case.problem.material, 1.0, Relaxation(steps=20000, tolerance=1e-8))
+    assert path.at_rest
+    K = system.elastic_stiffness()
+    U = np.zeros(K.shape[0])
+    free = system.free
+    U[free] = spsolve(K[free][:, free].tocsc(), system.external_force(1.0)[free])
+    assert np.abs(system.U - U).max() < 1e-6 * np.abs(U).max()
+
+
+def test_relaxation_search_brackets_and_records_the_displacement_history() -> None:
+    case = benchmarks.load("slope", ["parameters.h=1.25", 'strength-reduction.solver="dynamic-relaxation"',
+                                     "strength-reduction.values=[1.0, 1.6]", "dynamic.record_every=50"])
+    r = solve(case)
+    at_rest, moving = r.history
+    assert at_rest["stable"] and not moving["stable"] and "still moving" in moving["criterion"]
+    path = np.array(moving["displacement_history"])
+    assert path[-1, 1] > 2 * path[len(path) // 2, 1]                 # the displacement keeps growing
+    assert r.outcome["factor_of_safety"]["criterion"].startswith("still moving")
+
+
+def test_dynamic_section_needs_a_relaxation_analysis() -> None:
+    with pytest.raises(ProblemError, match="dynamic"):
+        benchmarks.load("slope", ["dynamic.steps=100"])
