@@ -5,10 +5,18 @@ The strengths are divided by the strength reduction factor SRF,
     c' = c / SRF,       tan(phi') = tan(phi) / SRF,       tan(psi') = tan(psi) / SRF,
 
 (the paper reduces c and phi; psi is reduced the same way so that psi' <= phi' stays true; with psi = 0
-it stays 0), and the body is equilibrated under its full loads. A level is **failed** when Newton
-cannot reach equilibrium: the SRF sub-step was cut back ``loading.max_cutbacks`` times and still did
-not converge within ``loading.max_iterations`` iterations (the criterion recorded with every level;
-the displacement of the last iterate is recorded too, and grows without bound at a failed level).
+it stays 0), and the body is equilibrated under its full loads, by one of two solvers:
+
+- ``solver = "newton"``: load stepping (:mod:`ctmrpim.load_stepping`); a level is **failed** when Newton
+  cannot reach equilibrium: the SRF sub-step was cut back ``loading.max_cutbacks`` times and still did
+  not converge within ``loading.max_iterations`` iterations;
+- ``solver = "dynamic-relaxation"`` (the paper's, :mod:`ctmrpim.dynamic_relaxation`): the reduction
+  applied at once and relaxed; a level is **failed** when it is still moving after ``dynamic.steps``
+  steps (not at rest, and its maximum displacement grew by more than ``SETTLED_GROWTH`` over the last
+  quarter of the steps: the paper's "the displacement increases continuously").
+
+The criterion is recorded with every level, with the maximum displacement (of the last iterate or
+step at a failed level, where it grows without bound).
 
 Search (``values`` empty): the gravity stage is solved once at SRF = ``start`` (loads ramped by the
 load stepping), then SRF rises by ``step`` from the last stable state, each level continuing from the

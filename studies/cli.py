@@ -19,3 +19,13 @@ def main(module: ModuleType) -> None:
     a = ap.parse_args()
     sweep = Sweep(CACHE, workers=a.workers, scheduler=a.scheduler)
     print(run_study(module, a.quick, Path(a.out), sweep).to_string(index=False))
+
+
+def fields_main(module: ModuleType) -> None:
+    """``python -m studies.NAME [--quick] [--out DIR]`` for the field studies, which run their cases
+    directly (they need fields, not cached summaries) through ``module.run(quick, out_dir)``."""
+    ap = argparse.ArgumentParser(description=(module.__doc__ or "").strip().splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="the small version CI runs")
+    ap.add_argument("--out", default="reports", help="folder for the PNG (default reports/)")
+    a = ap.parse_args()
+    print(module.run(a.quick, Path(a.out)))

@@ -60,9 +60,7 @@ def run(quick: bool = True, out_dir: Path = Path("reports"), progress=print) -> 
 
 
 if __name__ == "__main__":
-    import argparse
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--out", default="reports")
-    a = ap.parse_args()
-    print(run(a.quick, Path(a.out)))
+    import sys
+
+    from .cli import fields_main
+    fields_main(sys.modules[__name__])
