@@ -5,7 +5,10 @@ element discretisation of the same Problem.
 The system only needs the displacement-gradient operator G at the quadrature points and their
 weights: here G is built from the element basis (``basis.basis[i][0].grad`` of each local dof), the
 points are the elements' quadrature points, and the loads come from the same forms as the linear
-reference. Stresses and plastic strains are L2-projected onto the scalar space for output and probes.
+reference. For output, stresses and plastic strains are averaged onto the vertices with the lumped
+(row-sum) mass of the linear hat functions: a consistent projection onto P2 oscillates around a
+localised shear band (measured: nodal plastic strain down to -0.0033 beside a peak of 0.0046), the lumped
+one keeps a positive field positive. Probes read the consistent projection onto the element's space.
 """
 from __future__ import annotations
 
@@ -15,7 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse import csc_matrix
 from scipy.sparse.linalg import splu
-from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm
+from skfem import Basis, BilinearForm, ElementQuad1, ElementTriP1, ElementVector, FacetBasis, LinearForm
 
 from ctmrpim.elastoplastic import PlasticOutput, PlasticSystem, run_elastoplastic
 from ctmrpim.errors import ProblemError
@@ -28,6 +31,8 @@ from .mesh import build_mesh
 from .solve import (FACET_ORDER, SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate, _selected_facets,
                     _value)
 
+#: The linear element on the same cells: its hat functions average point values onto the vertices.
+LINEAR_ELEMENTS = {"q1": ElementQuad1, "p1": ElementTriP1, "p2": ElementTriP1}
 #: Quadrature degree: the strain of P2 is linear, so degree 2 integrates the elastic stiffness exactly.
 PLASTIC_ORDER = {"q1": 2, "p1": 1, "p2": 2}
 
@@ -73,7 +78,8 @@ def solve_fem_elastoplastic(case: Case, element: str = "p2",
                            lambda factor: factor * F_dead, body, problem.material, tangent=case.loading.tangent)
     mass = splu(csc_matrix(BilinearForm(lambda u, v, w_: u * v).assemble(scalar)))
     nel, nq = basis.nelems, basis.X.shape[-1]
-    vertices = scalar.nodal_dofs[0]
+    hats = basis.with_element(LINEAR_ELEMENTS[element]())
+    lumped = LinearForm(lambda f, w_: f).assemble(hats)
     probe_at = [_locate(mesh, np.array([p.x, p.y]), fm.d_c, p.name) for p in problem.probes]
     probe_u = [basis.probes(at) for at in probe_at]
     probe_s = [scalar.probes(at) for at in probe_at]
@@ -86,6 +92,13 @@ def solve_fem_elastoplastic(case: Case, element: str = "p2",
                                for k in range(v.shape[-1])])
         return mass.solve(rhs)
 
+    def vertex_average(values: np.ndarray) -> np.ndarray:
+        """(nvertices, k) lumped-mass average of point values (m, k) onto the vertices."""
+        v = values.reshape(nel, nq, -1)
+        rhs = np.column_stack([LinearForm(lambda f, w_: w_.s * f).assemble(hats, s=v[:, :, k])
+                               for k in range(v.shape[-1])])
+        return rhs / lumped[:, None]
+
     def probe_values(U: np.ndarray, stress: np.ndarray | None) -> dict:
         s_dofs = projected(stress) if stress is not None else None
         out = {}
@@ -97,7 +110,7 @@ def solve_fem_elastoplastic(case: Case, element: str = "p2",
     material = problem.material
     out = PlasticOutput(
         method=f"fem-{element}-mc", points=mesh.p.T.copy(), cells=[(fm.cell_type, fm.cells)],
-        displacement=lambda U: U[basis.nodal_dofs].T.copy(), nodal=lambda v: projected(v)[vertices],
+        displacement=lambda U: U[basis.nodal_dofs].T.copy(), nodal=vertex_average,
         probe_values=probe_values, peak_traction=_peak_traction(problem, fm, vec, tol),
         counts={"nodes": int(mesh.nvertices), "dofs": int(basis.N), "elements": int(mesh.nelements),
                 "integration_points": len(w)},

@@ -48,9 +48,33 @@ def test_factor_of_safety_bracket_against_bishop(results, name: str, solver: str
     assert levels[0]["srf"] == 1.0 and levels[0]["stable"]
     assert all(h["stable"] for h in levels if h["srf"] <= stable)
     assert all(not h["stable"] and h["criterion"] == "non-convergence" for h in levels if h["srf"] >= failed)
-    # the failed level's plastic zone: a band of strained points, not scattered ones
-    plastic = r.series[-1]["fields"]["plastic_strain"]
-    assert r.series[-1]["time"] == failed and np.percentile(plastic, 99) > 5 * np.median(plastic)
+    # as the paper's Fig. 20: isolated plastic zones at SRF = 1, a band from the toe up through the slope at failure
+    problem = benchmarks.load(name).problem
+    assert r.series[0]["time"] == 1.0 and r.series[-1]["time"] == failed
+    assert not shear_band_connects_crest_and_toe(r.points, r.series[0]["fields"]["plastic_strain"], problem)
+    assert shear_band_connects_crest_and_toe(r.points, r.series[-1]["fields"]["plastic_strain"], problem)
+
+
+def shear_band_connects_crest_and_toe(points: np.ndarray, plastic: np.ndarray, problem) -> bool:
+    """The strained nodes (equivalent plastic strain above 0.3 x its 99th percentile) hold one connected
+    cluster (neighbours within 1.5 spacings) that contains the toe of the slope and rises to three
+    quarters of the slope's height: a shear band through the slope, not isolated plastic zones."""
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    from ctmrpim.limit_equilibrium import top_surface
+    surface = top_surface(problem.geometry)
+    crest, toe = surface[1], surface[-2] if len(surface) > 3 else surface[-1]   # the slope's upper and lower ends
+    band = np.flatnonzero(plastic > 0.3 * np.percentile(plastic, 99))
+    spacing = np.sqrt(problem.geometry.area / len(points))
+    pairs = cKDTree(points[band]).query_pairs(1.5 * spacing, output_type="ndarray")
+    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(band),) * 2)
+    _, label = connected_components(graph, directed=False)
+    at_toe = np.linalg.norm(points[band] - toe, axis=1) < 3 * spacing
+    for cluster in set(label[at_toe]):
+        if points[band][label == cluster, 1].max() >= toe[1] + 0.75 * (crest[1] - toe[1]):
+            return True
+    return False
 
 
 @pytest.mark.parametrize("solver, tag", [("ctm-rpim", "ctmrpim"), ("fem", "fem-p2")])
