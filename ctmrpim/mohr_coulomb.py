@@ -11,6 +11,9 @@ apex. Each is tried in that order and accepted when its multipliers are non-nega
 returned stresses keep their order. The apex, s_i = c cot(phi), exists only for phi > 0; no cot(phi)
 or 1/sin(phi) appears elsewhere, so phi -> 0 (the undrained footing) stays finite.
 
+An optional tension cut-off s1 <= sigma_t (``tension``; Rankine planes, associated) is returned to with
+the Mohr-Coulomb planes as one multi-surface problem where it binds (:meth:`MohrCoulomb._cut_off`).
+
 The consistent tangent d sigma_{n+1} / d(strain increment) is the exact derivative of this return
 map within its region, by complex steps (three in-plane strain components): every branch decision is
 made on the real part, and the 2 x 2 eigen-decomposition is written in closed form.
@@ -31,7 +34,7 @@ YIELD_TOL = 1e-10
 #: closed-form eigenvectors (and their complex-step derivatives) stay defined.
 EIGEN_GAP = 1e-12
 
-ELASTIC, MAIN, RIGHT, LEFT, APEX = 0, 1, 2, 3, 4
+ELASTIC, MAIN, RIGHT, LEFT, APEX, TENSION = 0, 1, 2, 3, 4, 5
 
 
 @dataclass(frozen=True)
@@ -42,6 +45,7 @@ class MohrCoulomb:
     phi: float          # degrees
     psi: float = 0.0    # degrees
     density: float = 0.0
+    tension: float | None = None    # tension cut-off sigma_t (largest principal stress), None: none
 
     def __post_init__(self) -> None:
         for key, ok in (("E", self.E > 0), ("nu", -1.0 < self.nu < 0.5), ("c", self.c >= 0),
@@ -49,6 +53,8 @@ class MohrCoulomb:
                         ("density", self.density >= 0)):
             if not ok:
                 raise ProblemError(f"{getattr(self, key)!r} is out of range", key=f"material.{key}")
+        if self.tension is not None and not self.tension >= 0:
+            raise ProblemError(f"{self.tension!r} must be >= 0 (a tensile strength)", key="material.tension")
         if self.c == 0 and self.phi == 0:
             raise ProblemError("c = 0 and phi = 0: the material has no strength", key="material.c")
 
@@ -106,7 +112,7 @@ class MohrCoulomb:
         scale = self.c + np.abs(s.real).max(axis=1)
         plastic = f.real > YIELD_TOL * scale
         if not plastic.any():
-            return out, region
+            return self._cut_off(trial, out, region)
         s, vec, f = s[plastic], tuple(v[plastic] for v in vec), f[plastic]
         ret = np.empty_like(s)
         reg = np.zeros(len(s), dtype=np.int8)
@@ -153,7 +159,38 @@ class MohrCoulomb:
         sigma = _assemble(ret, vec)
         out[plastic] = sigma
         region[plastic] = reg
+        return self._cut_off(trial, out, region)
+
+    def _cut_off(self, trial: np.ndarray, out: np.ndarray, region: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The tension cut-off s1 <= sigma_t on top of the Mohr-Coulomb return. Where the Mohr-Coulomb
+        answer (or the elastic trial) breaks it, the return is redone from the trial with the tension
+        planes active (Rankine, associated: s_i = sigma_t, i = 1 [, 2 [, 3]]) alone or together with
+        the main plane and one of its edges: the candidate active sets are tried with the fewest planes
+        first, each a small linear system in principal space (the surfaces are planes and the elasticity
+        is linear), and the first whose multipliers are non-negative, whose stresses keep their order
+        and satisfy every surface is taken (the multi-surface return of Simo & Hughes, Sec. 5.3)."""
+        if self.tension is None:
+            return out, region
+        s_out, _ = _principal(out)
+        broken = s_out[:, 0].real > self.tension + YIELD_TOL * (self.c + np.abs(s_out.real).max(axis=1))
+        if not broken.any():
+            return out, region
+        s, vec = _principal(trial[broken])
+        ret, reg = _multi_surface_return(s, self._planes(), self.G, self.K)
+        out[broken] = _assemble(ret, vec)
+        region[broken] = reg
         return out, region
+
+    def _planes(self) -> dict[str, tuple[np.ndarray, np.ndarray, float]]:
+        """Yield planes a . s = k in principal space with their flow directions b: (a, b, k)."""
+        sp_, cp = np.sin(np.radians(self.phi)), np.cos(np.radians(self.phi))
+        sq = np.sin(np.radians(self.psi))
+        two_c = 2.0 * self.c * cp
+        e = np.eye(3)
+        return {"main": (np.array([1 + sp_, 0, -(1 - sp_)]), np.array([1 + sq, 0, -(1 - sq)]), two_c),
+                "right": (np.array([0, 1 + sp_, -(1 - sp_)]), np.array([0, 1 + sq, -(1 - sq)]), two_c),
+                "left": (np.array([1 + sp_, -(1 - sp_), 0]), np.array([1 + sq, -(1 - sq), 0]), two_c),
+                "t1": (e[0], e[0], self.tension), "t2": (e[1], e[1], self.tension), "t3": (e[2], e[2], self.tension)}
 
 
 def plastic_strain_increment(material: "MohrCoulomb", dstrain: np.ndarray, dstress: np.ndarray) -> np.ndarray:
@@ -171,6 +208,45 @@ def equivalent_plastic_strain(plastic_strain: np.ndarray) -> np.ndarray:
     mean = (plastic_strain[:, 0] + plastic_strain[:, 1] + plastic_strain[:, 3]) / 3.0
     dev = plastic_strain[:, [0, 1, 3]] - mean[:, None]
     return np.sqrt(2.0 / 3.0 * ((dev ** 2).sum(axis=1) + 2.0 * plastic_strain[:, 2] ** 2))
+
+
+#: Active sets tried, fewest planes first, where the tension cut-off is broken (one tension plane at least).
+CUT_OFF_SETS = (("t1",), ("main", "t1"), ("t1", "t2"), ("main", "right", "t1"), ("main", "left", "t1"),
+                ("main", "t1", "t2"), ("t1", "t2", "t3"))
+
+
+def _multi_surface_return(s: np.ndarray, planes: dict, G: float, K: float) -> tuple[np.ndarray, np.ndarray]:
+    """Return sorted principal trial stresses (m, 3) onto the intersection of the planes of the first
+    admissible active set of CUT_OFF_SETS: s = s_trial - sum_k gamma_k D b_k with a_j . s = k_j on the
+    active planes, gamma >= 0, every plane satisfied and s1 >= s2 >= s3. Complex-step safe."""
+    lam = K - 2.0 * G / 3.0
+    D = lam * np.ones((3, 3)) + 2.0 * G * np.eye(3)
+    a_all = np.array([p[0] for p in planes.values()])
+    k_all = np.array([p[2] for p in planes.values()])
+    ret = s.copy()
+    reg = np.full(len(s), TENSION, dtype=np.int8)
+    todo = np.ones(len(s), dtype=bool)
+    scale = 1.0 + np.abs(s.real).max(axis=1)
+    for active in CUT_OFF_SETS:
+        if not todo.any():
+            break
+        a = np.array([planes[n][0] for n in active])                     # (q, 3)
+        Db = np.array([D @ planes[n][1] for n in active])               # (q, 3)
+        k = np.array([planes[n][2] for n in active])
+        A = a @ Db.T                                                     # (q, q): a_j . D b_l
+        gamma = (s[todo] @ a.T - k) @ np.linalg.inv(A).T                 # (t, q)
+        cand = s[todo] - gamma @ Db
+        tol = 1e-9 * scale[todo]
+        ok = ((gamma.real >= -1e-12 * scale[todo, None]).all(axis=1)
+              & ((cand.real @ a_all.T - k_all) <= tol[:, None]).all(axis=1)
+              & (cand[:, 0].real >= cand[:, 1].real - tol) & (cand[:, 1].real >= cand[:, 2].real - tol))
+        idx = np.flatnonzero(todo)[ok]
+        ret[idx] = cand[ok]
+        todo[idx] = False
+    if todo.any():
+        raise ProblemError("Mohr-Coulomb with tension cut-off: no admissible return for a trial stress "
+                           f"(e.g. principal {s[np.flatnonzero(todo)[0]].real}); the strain increment is too large")
+    return ret, reg
 
 
 def _principal(stress: np.ndarray):

@@ -34,7 +34,7 @@ SECTIONS: dict[str, set[str] | None] = {
     "parameters": None,  # any names
     "geometry": {"add", "subtract"},
     "nodes": {"grid", "spacing", "file"},
-    "material": {"model", "E", "nu", "density", "c", "phi", "psi"},
+    "material": {"model", "E", "nu", "density", "c", "phi", "psi", "tension"},
     "method": set(Method.__dataclass_fields__),
     "constraint": {"where", "ux", "uy"},
     "traction": {"where", "tx", "ty", "follower"},
@@ -204,8 +204,10 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         missing = [k for k in ("c", "phi") if k not in mat]
         if missing:
             raise ProblemError(f"model 'mohr-coulomb' needs {' and '.join(missing)}", key=f"material.{missing[0]}")
+        tension = get("material", "tension", None)
         material = MohrCoulomb(material.E, material.nu, num(mat["c"], "material.c"), num(mat["phi"], "material.phi"),
-                               num(get("material", "psi", 0.0), "material.psi"), material.density)
+                               num(get("material", "psi", 0.0), "material.psi"), material.density,
+                               None if tension is None else num(tension, "material.tension"))
         if plane != "strain":
             raise ProblemError("the Mohr-Coulomb model is implemented in plane strain; set problem.plane = \"strain\"",
                                key="problem.plane")
@@ -353,7 +355,7 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
                      for k, shapes in (("add", geometry.add), ("subtract", geometry.subtract))},
         "nodes": nodes.as_dict(),
         "material": {"model": mat["model"], "E": material.E, "nu": material.nu, "density": material.density,
-                     **({"c": material.c, "phi": material.phi, "psi": material.psi}
+                     **({"c": material.c, "phi": material.phi, "psi": material.psi, "tension": material.tension}
                         if isinstance(material, MohrCoulomb) else {})},
         "method": method.as_dict(),
         "constraint": [{k: str(v) for k, v in c.items()} for c in raw.get("constraint", [])],

@@ -4,8 +4,8 @@ The strengths are divided by the strength reduction factor SRF,
 
     c' = c / SRF,       tan(phi') = tan(phi) / SRF,       tan(psi') = tan(psi) / SRF,
 
-(the paper reduces c and phi; psi is reduced the same way so that psi' <= phi' stays true; with psi = 0
-it stays 0), and the body is equilibrated under its full loads, by one of two solvers:
+(the paper reduces c and phi; psi is reduced the same way so that psi' <= phi' stays true, with psi = 0
+it stays 0; a tension cut-off, a strength like c, is divided by SRF too), and the body is equilibrated under its full loads, by one of two solvers:
 
 - ``solver = "newton"``: load stepping (:mod:`ctmrpim.load_stepping`); a level is **failed** when Newton
   cannot reach equilibrium: the SRF sub-step was cut back ``loading.max_cutbacks`` times and still did
@@ -84,7 +84,8 @@ def reduced(material: MohrCoulomb, srf: float) -> MohrCoulomb:
     """The material with its strength divided by ``srf`` (Eqs. 38-39)."""
     def angle(a: float) -> float:
         return math.degrees(math.atan(math.tan(math.radians(a)) / srf))
-    return replace(material, c=material.c / srf, phi=angle(material.phi), psi=angle(material.psi))
+    tension = None if material.tension is None else material.tension / srf
+    return replace(material, c=material.c / srf, phi=angle(material.phi), psi=angle(material.psi), tension=tension)
 
 
 @dataclass

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ctmrpim.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, MohrCoulomb, _principal
+from ctmrpim.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, TENSION, MohrCoulomb, _principal
 
 E, NU, C = 1.0e8, 0.3, 1.0e4
 ON_SURFACE = 1e-9           # |f| / (c + max |sigma|) after a return: round-off
@@ -161,3 +161,65 @@ def test_every_return_region_occurs() -> None:
     stress, de = cloud(1)
     _, region = MohrCoulomb(E=E, nu=NU, c=C, phi=20.0, psi=0.0).update(stress, de)
     assert set(np.unique(region)) == {ELASTIC, MAIN, RIGHT, LEFT, APEX}
+
+
+cut_off_materials = st.builds(lambda phi, dpsi, t: MohrCoulomb(E=E, nu=NU, c=C, phi=phi, psi=phi * dpsi, tension=t * C),
+                              st.floats(0.001, 45.0), st.floats(0.0, 1.0), st.floats(0.0, 1.0))
+
+
+def tensile_cloud(seed: int, m: int = 400):
+    """Stress states around zero mean stress and strain increments that pull: the cut-off binds."""
+    rng = np.random.default_rng(seed)
+    return rng.standard_normal((m, 4)) * 2e4, rng.standard_normal((m, 3)) * 2e-4 + np.array([1e-4, 1e-4, 0])
+
+
+@settings(max_examples=40, deadline=None)
+@given(cut_off_materials, st.integers(0, 10_000))
+def test_tension_cut_off_returns_onto_both_surfaces(mat: MohrCoulomb, seed: int) -> None:
+    stress, de = tensile_cloud(seed)
+    s, region = mat.update(stress, de)
+    p, _ = _principal(s)
+    scale = mat.c + np.abs(s).max(axis=1)
+    assert np.all(p[:, 0] <= mat.tension + ON_SURFACE * scale)                   # s1 <= sigma_t everywhere
+    assert np.all(mat.yield_function(s) <= ON_SURFACE * scale)                  # and inside Mohr-Coulomb
+    cut = region == TENSION
+    assert cut.any()
+    assert np.all(np.abs(p[cut, 0] - mat.tension) <= ON_SURFACE * scale[cut])    # on the cut-off where it acted
+    # the flow of a tension plane is along its normal: the other principal stresses move by lambda / (lambda + 2G)
+    # of the first one's correction (one active plane), so the returned state stays in the trial's frame
+    trial = elastic_trial(mat, stress, de)
+    out_r, _ = mat.update(stress, de)
+    assert np.array_equal(out_r, s)                                            # deterministic
+    inside = (mat.yield_function(trial) < 0) & (_principal(trial)[0][:, 0] < mat.tension)
+    assert np.array_equal(s[inside], trial[inside])                            # admissible trials untouched
+
+
+@settings(max_examples=25, deadline=None)
+@given(cut_off_materials, st.integers(0, 10_000))
+def test_tension_cut_off_tangent_matches_finite_differences(mat: MohrCoulomb, seed: int) -> None:
+    stress, de = tensile_cloud(seed, m=200)
+    T = mat.tangent(stress, de)
+    h = 1e-8
+    fd = np.empty_like(T)
+    _, region = mat.update(stress, de)
+    same = np.ones(len(de), bool)
+    for k in range(3):
+        dp, dm = de.copy(), de.copy()
+        dp[:, k] += h
+        dm[:, k] -= h
+        (sp_, rp), (sm_, rm) = mat.update(stress, dp), mat.update(stress, dm)
+        fd[:, :, k] = (sp_[:, :3] - sm_[:, :3]) / (2 * h)
+        same &= (rp == region) & (rm == region)
+    err = np.abs(T - fd).max(axis=(1, 2))
+    assert (same & (region == TENSION)).any()
+    assert np.all(err[same] <= TANGENT_FD * E)
+
+
+def test_uniaxial_pull_stops_at_the_tensile_strength() -> None:
+    """A stress-free point pulled in x (plane strain): s_xx rises elastically to sigma_t and stays there."""
+    mat = MohrCoulomb(E=E, nu=NU, c=C, phi=30.0, psi=0.0, tension=2e3)
+    stress = np.zeros((1, 4))
+    for _ in range(20):
+        stress, region = mat.update(stress, np.array([[5e-6, 0.0, 0.0]]))
+    assert region[0] == TENSION and stress[0, 0] == pytest.approx(2e3, rel=1e-12)
+    assert MohrCoulomb(E=E, nu=NU, c=C, phi=30.0).update(np.zeros((1, 4)), np.array([[1e-4, 0, 0]]))[0][0, 0] > 2e3

@@ -213,3 +213,11 @@ def test_relaxation_search_brackets_and_records_the_displacement_history() -> No
 def test_dynamic_section_needs_a_relaxation_analysis() -> None:
     with pytest.raises(ProblemError, match="dynamic"):
         benchmarks.load("slope", ["dynamic.steps=100"])
+
+
+def test_tension_cut_off_is_read_and_reduced_with_the_strength() -> None:
+    case = benchmarks.load("slope", ["material.tension=2e3"])
+    assert case.problem.material.tension == 2e3 and case.resolved["material"]["tension"] == 2e3
+    assert reduced(case.problem.material, 2.0).tension == 1e3
+    with pytest.raises(ProblemError, match="material.tension"):
+        benchmarks.load("slope", ["material.tension=-1"])
