@@ -216,37 +216,34 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     sr_raw = raw.get("strength-reduction")
     if sr_raw is not None and analysis != "strength-reduction":
         raise ProblemError("[strength-reduction] needs analysis = \"strength-reduction\"", key="problem.analysis")
-    strength_reduction = None
-    if analysis == "strength-reduction":
-        sr = {}
-        for key, spec in StrengthReduction.__dataclass_fields__.items():
-            if key not in (sr_raw or {}):
-                defaults.append(f"strength-reduction.{key} = {spec.default!r}")
+    def settings(cls, section: str, table: dict | None, numbers: tuple[str, ...]):
+        """A settings dataclass from its table: defaults recorded, ``numbers`` read as expressions."""
+        kwargs = {}
+        for key, spec in cls.__dataclass_fields__.items():
+            if key not in (table or {}):
+                defaults.append(f"{section}.{key} = {spec.default!r}")
                 continue
-            v = sr_raw[key]
+            v = table[key]
             if key == "values":
                 if not isinstance(v, list):
-                    raise ProblemError(f"{v!r} must be a list of SRF values", key="strength-reduction.values")
-                v = [num(e, "strength-reduction.values") for e in v]
-            elif key in ("start", "step", "width", "max_srf"):
-                v = num(v, f"strength-reduction.{key}")
-            sr[key] = v
-        strength_reduction = StrengthReduction(**sr)
+                    raise ProblemError(f"{v!r} must be a list of SRF values", key=f"{section}.values")
+                v = [num(e, f"{section}.values") for e in v]
+            elif key in numbers:
+                v = num(v, f"{section}.{key}")
+            kwargs[key] = v
+        return cls(**kwargs)
+
+    strength_reduction = None
+    if analysis == "strength-reduction":
+        strength_reduction = settings(StrengthReduction, "strength-reduction", sr_raw,
+                                      ("start", "step", "width", "max_srf"))
     dyn_raw = raw.get("dynamic")
     uses_relaxation = analysis == "dynamic" or (strength_reduction is not None
                                                 and strength_reduction.solver == "dynamic-relaxation")
     if dyn_raw is not None and not uses_relaxation:
         raise ProblemError("[dynamic] needs analysis = \"dynamic\" or strength-reduction.solver = "
                            "\"dynamic-relaxation\"", key="dynamic")
-    relaxation = None
-    if uses_relaxation:
-        dyn = {}
-        for key, spec in Relaxation.__dataclass_fields__.items():
-            if key not in (dyn_raw or {}):
-                defaults.append(f"dynamic.{key} = {spec.default!r}")
-                continue
-            dyn[key] = num(dyn_raw[key], f"dynamic.{key}") if key in ("damping", "tolerance") else dyn_raw[key]
-        relaxation = Relaxation(**dyn)
+    relaxation = settings(Relaxation, "dynamic", dyn_raw, ("damping", "tolerance")) if uses_relaxation else None
     if loading.tangent == "elastic" and mat["model"] != "mohr-coulomb":
         raise ProblemError("tangent = \"elastic\" is the Mohr-Coulomb solver's iteration; large-deformation "
                            "solvers use the consistent tangent", key="loading.tangent")

@@ -17,8 +17,8 @@ from ctmrpim.linear_static import Timer
 BLOCK = Path(__file__).parent / "data" / "mc_block.toml"
 
 
-def plateau_reaction(phi: float) -> tuple[float, float, object]:
-    case = load_target(str(BLOCK), [f"parameters.phi={phi!r}"])
+def plateau_reaction(phi: float, psi: float = 0.0) -> tuple[float, float, object]:
+    case = load_target(str(BLOCK), [f"parameters.phi={phi!r}", f"material.psi={psi!r}"])
     mat = case.problem.material
     system, _ = elastoplastic.ctm_plastic_system(case, Timer())
     system.run(case.loading, lambda t: mat, lambda t: t, lambda t, U: {})
@@ -33,9 +33,10 @@ def system_points(case) -> np.ndarray:
     return discretise(case, Timer()).nodes[:, 1]
 
 
-@pytest.mark.parametrize("phi, key", [(0.001, "mc-block-tresca-plateau"), (30.0, "mc-block-plateau")])
-def test_compressed_block_reaches_the_plateau(phi: float, key: str) -> None:
-    reaction, exact, r = plateau_reaction(phi)
+@pytest.mark.parametrize("phi, psi, key", [(0.001, 0.0, "mc-block-tresca-plateau"), (30.0, 0.0, "mc-block-plateau"),
+                                           (30.0, 30.0, "mc-block-plateau-associated")])
+def test_compressed_block_reaches_the_plateau(phi: float, psi: float, key: str) -> None:
+    reaction, exact, r = plateau_reaction(phi, psi)
     check(key, abs(reaction / exact - 1.0))
     assert r.history[-1]["converged"] and r.history[-1]["plastic_points"] > 0
     assert r.counts["plastic_points"] == r.history[-1]["plastic_points"]
