@@ -67,14 +67,16 @@ def describe(result: Result, case: Case) -> str:
             lines.append(f"  factor of safety not bracketed: stable up to {fos['stable']}, failed from {fos['failed']}")
     relaxed = result.outcome.get("relaxation")
     if relaxed is not None:
-        lines.append(f"  dynamic relaxation: {'at rest' if relaxed['at_rest'] else 'NOT at rest'} after {relaxed['steps']} "
+        state = "at rest" if relaxed["at_rest"] else "NOT at rest"
+        lines.append(f"  dynamic relaxation: {state} after {relaxed['steps']} "
                      f"steps (out-of-balance force {relaxed['residual']:.2e} of the loads)")
     limit = result.outcome.get("limit_pressure")
     if limit is not None:
         if limit["failed"] is None:
             lines.append(f"  the full load was carried (peak traction {limit['carried']:.6g}): no limit load below it")
         else:
-            lines.append(f"  limit load: carried {limit['carried']:.6g}, not carried {limit['failed']:.6g} (peak traction; "
+            lines.append(f"  limit load: carried {limit['carried']:.6g}, not carried {limit['failed']:.6g} "
+                         f"(peak traction; "
                          f"load factor {result.outcome['limit_load_factor']['carried']:.5g} .. "
                          f"{result.outcome['limit_load_factor']['failed']:.5g})")
     if "load_increments" in c:

@@ -81,7 +81,8 @@ def stability_checks(slopes: pd.DataFrame, footing: pd.DataFrame) -> pd.DataFram
     rows = []
     for _, r in slopes[slopes.status == "ok"].iterrows():
         rows.append(_row(f"{r.slope}-{tag[r.method]}-fs", r.worst_rel_diff, f"{r.nodes} nodes"))
-        rows.append(_row("slope-fs-bracket-width", r.fs_failed - r.fs_stable, f"{r.slope}, {r.method}, {r.nodes} nodes"))
+        rows.append(_row("slope-fs-bracket-width", r.fs_failed - r.fs_stable,
+                         f"{r.slope}, {r.method}, {r.nodes} nodes"))
     ok = footing[(footing.status == "ok") & footing.grid.isin(["49 x 21", "73 x 31"])]
     for _, r in ok.iterrows():
         rows.append(_row(f"footing-{tag[r.method]}-limit", r.worst_rel_diff, f"{r.grid} nodes"))
@@ -273,7 +274,8 @@ def stability_side_by_side(slopes: pd.DataFrame, footing: pd.DataFrame) -> pd.Da
         d = slopes[slopes.slope == name]
         ours, fem = finest(d, "ctm-rpim"), finest(d, "fem-p2")
         rows.append({"benchmark": f"{name}: factor of safety", "paper": paper,
-                     "CTM-RPIM": "" if ours is None else f"[{ours.fs_stable:.4f}, {ours.fs_failed:.4f}] ({ours.nodes} nodes)",
+                     "CTM-RPIM": "" if ours is None
+                     else f"[{ours.fs_stable:.4f}, {ours.fs_failed:.4f}] ({ours.nodes} nodes)",
                      "scikit-fem P2": "" if fem is None else f"[{fem.fs_stable:.4f}, {fem.fs_failed:.4f}]",
                      "analytical / limit equilibrium": analytical})
     ours, fem = finest(footing, "ctm-rpim"), finest(footing, "fem-p2")
@@ -301,9 +303,11 @@ def _stability_section(w, tables: dict[str, pd.DataFrame], quick: bool, out_dir:
     w("\n\n![slope stability](slope_stability.png)\n\n")
     w("Measured at the default resolution (full mode, and `python benchmarks/bench_stability.py`): `slope` "
       "CTM-RPIM [1.3406, 1.3422] in 24 s, P2 [1.3406, 1.3438] in 14 s; `slope-gl` CTM-RPIM [1.3438, 1.3469] in "
-      "27 s, P2 [1.3438, 1.3469] in 12 s: both methods agree within 0.003 and lie 2-2.5 % below Bishop's simplified method (1.368, 1.378), inside "
+      "27 s, P2 [1.3438, 1.3469] in 12 s: both methods agree within 0.003 and lie 2-2.5 % below Bishop's "
+      "simplified method (1.368, 1.378), inside "
       "the paper's [1.3, 1.4] and below Griffiths & Lane's finite-element 1.4. The coarser clouds give 0.5-1 % "
-      "more. The bracket is that of a numerical criterion: Newton's non-convergence within 100 iterations at a "
+      "more. The bracket is that of a numerical criterion: non-convergence of the equilibrium iteration "
+      "within 100 iterations at a "
       "tolerance of 1e-4 after four halvings of the SRF step; with 300 iterations it moves up by about 0.004, "
       "and round-off in the factorisation moves it by up to 0.003. The gravity stage yields a wide zone at "
       "depth (with nu = 0.3 the elastic K0 = 0.43 state lies on the Mohr-Coulomb edge sigma_xx = sigma_zz "

@@ -5,7 +5,8 @@ The strengths are divided by the strength reduction factor SRF,
     c' = c / SRF,       tan(phi') = tan(phi) / SRF,       tan(psi') = tan(psi) / SRF,
 
 (the paper reduces c and phi; psi is reduced the same way so that psi' <= phi' stays true, with psi = 0
-it stays 0; a tension cut-off, a strength like c, is divided by SRF too), and the body is equilibrated under its full loads, by one of two solvers:
+it stays 0; a tension cut-off, a strength like c, is divided by SRF too), and the body is equilibrated
+under its full loads, by one of two solvers:
 
 - ``solver = "newton"``: load stepping (:mod:`ctmrpim.load_stepping`); a level is **failed** when Newton
   cannot reach equilibrium: the SRF sub-step was cut back ``loading.max_cutbacks`` times and still did
@@ -43,7 +44,8 @@ from .mohr_coulomb import MohrCoulomb, equivalent_plastic_strain, plastic_strain
 from .result import Result
 
 SOLVERS = ("newton", "dynamic-relaxation")
-CRITERION = {"newton": "non-convergence: Newton did not reach the residual and displacement tolerance within "
+CRITERION = {"newton": "non-convergence: the equilibrium iteration (loading.tangent: Newton, or the elastic "
+                       "stiffness with Anderson mixing) did not reach the residual and displacement tolerance within "
                        "loading.max_iterations iterations at an SRF sub-step cut back loading.max_cutbacks times",
              "dynamic-relaxation": "still moving: after dynamic.steps steps of dynamic relaxation the out-of-balance "
                                    "force is above dynamic.tolerance of the loads and the maximum displacement grew "

@@ -2,7 +2,7 @@
 solved on its own at each SRF (gravity ramped from zero at the reduced strength, Griffiths & Lane's
 way; the sweep mode of the strength reduction, one case per SRF through the sweep executor, so the
 levels run in parallel). A stable level reports its converged maximum displacement; a failed level
-(Newton's non-convergence) the maximum displacement of its last iterate, which grows without bound.
+(the equilibrium iteration does not converge) the maximum displacement of its last iterate, which grows without bound.
 """
 from __future__ import annotations
 

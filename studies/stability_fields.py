@@ -38,7 +38,8 @@ def run(quick: bool = True, out_dir: Path = Path("reports"), progress=print) -> 
     stable = next(s for s in slope.series if s["time"] == fos["stable"])
     failed = next(s for s in slope.series if s["time"] == fos["failed"])
     vmax = float(np.percentile(failed["fields"]["plastic_strain"], 99))
-    for ax, step, what in ((slope_axes[0], stable, "last stable"), (slope_axes[1], failed, "first failed (last iterate)")):
+    for ax, step, what in ((slope_axes[0], stable, "last stable"),
+                           (slope_axes[1], failed, "first failed (last iterate)")):
         sc = ax.scatter(slope.points[:, 0], slope.points[:, 1], c=step["fields"]["plastic_strain"], s=4,
                         cmap="viridis", vmin=0, vmax=vmax)
         ax.set(title=f"slope, SRF = {step['time']:.4f} ({what})", xlabel="x (m)", ylabel="y (m)", aspect="equal")
