@@ -66,8 +66,8 @@ class RelaxationPath:
 def relaxation_mass(system) -> np.ndarray:
     """Per dof: the fictitious nodal mass (equal for a node's two dofs)."""
     K = abs(system.elastic_stiffness())
-    rows = np.asarray(K.sum(axis=1)).ravel()
-    return SAFETY * np.repeat(rows.reshape(-1, 2).max(axis=1), 2) if len(rows) % 2 == 0 else SAFETY * rows
+    rows = np.asarray(K.sum(axis=1)).ravel()          # dofs are interleaved (x, y) per node
+    return SAFETY * np.repeat(rows.reshape(-1, 2).max(axis=1), 2)
 
 
 def relax(system, material: MohrCoulomb, load_factor: float, settings: Relaxation,

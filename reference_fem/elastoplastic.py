@@ -120,13 +120,15 @@ def solve_fem_elastoplastic(case: Case, element: str = "p2",
 
 
 def _peak_traction(problem, fm, vec, tol: float) -> float:
-    """Largest traction magnitude on the loaded facets at full load (the limit pressure's scale)."""
+    """Largest traction or pressure magnitude on the loaded facets at full load (the limit pressure's
+    scale; the meshfree solver reports the same from its loaded segments)."""
     peak = 0.0
-    for tr in problem.tractions:
-        _, facets = _selected_facets(tr.where, fm, tol)
+    for where, components in ([(tr.where, (tr.tx, tr.ty)) for tr in problem.tractions]
+                              + [(pr.where, (pr.p,)) for pr in problem.pressures]):
+        _, facets = _selected_facets(where, fm, tol)
         if len(facets) == 0:
             continue
         xq = np.asarray(FacetBasis(fm.mesh, vec, facets=facets, intorder=FACET_ORDER).global_coordinates())
-        x, y = xq[0], xq[1]
-        peak = max(peak, float(np.hypot(_value(tr.tx, x, y), _value(tr.ty, x, y)).max()))
+        values = [_value(f, xq[0], xq[1]) for f in components]
+        peak = max(peak, float(np.sqrt(sum(v ** 2 for v in values)).max()))
     return peak

@@ -221,3 +221,16 @@ def test_tension_cut_off_is_read_and_reduced_with_the_strength() -> None:
     assert reduced(case.problem.material, 2.0).tension == 1e3
     with pytest.raises(ProblemError, match="material.tension"):
         benchmarks.load("slope", ["material.tension=-1"])
+
+
+def test_limit_pressure_is_the_same_for_a_traction_and_a_pressure(tmp_path) -> None:
+    """The footing's load written as [[pressure]] p instead of [[traction]] ty = -p: same limit, same scale."""
+    text = benchmarks.path("footing").read_text()
+    path = tmp_path / "footing_pressure.toml"
+    path.write_text(text.replace("[[traction]]", "[[pressure]]").replace('ty = "-q_max"', 'p = "q_max"'))
+    from ctmrpim.cli import load_target
+    coarse = ["parameters.nx=25", "parameters.ny=11"]
+    with_pressure = solve(load_target(str(path), coarse), "fem", "p2").outcome["limit_pressure"]
+    with_traction = solve(benchmarks.load("footing", coarse), "fem", "p2").outcome["limit_pressure"]
+    assert with_pressure == pytest.approx(with_traction, rel=1e-9)
+    assert with_pressure["carried"] == pytest.approx(PRANDTL, rel=0.03)
