@@ -63,6 +63,11 @@ class RelaxationPath:
         return (end - mark["max_displacement"]) / max(mark["max_displacement"], 1e-300)
 
 
+def max_displacement(U: np.ndarray) -> float:
+    """The largest nodal displacement of interleaved dofs U."""
+    return float(np.linalg.norm(U.reshape(-1, 2), axis=1).max())
+
+
 def relaxation_mass(system) -> np.ndarray:
     """Per dof: the fictitious nodal mass (equal for a node's two dofs)."""
     K = abs(system.elastic_stiffness())
@@ -92,8 +97,7 @@ def relax(system, material: MohrCoulomb, load_factor: float, settings: Relaxatio
             raise ProblemError(f"dynamic relaxation diverged at step {step} (non-finite forces)")
         at_rest = ratio <= settings.tolerance
         if step % settings.record_every == 0 or at_rest or step == settings.steps:
-            history.append({"step": step, "max_displacement": float(np.linalg.norm(U.reshape(-1, 2), axis=1).max()),
-                            "residual": ratio})
+            history.append({"step": step, "max_displacement": max_displacement(U), "residual": ratio})
         if at_rest:
             return RelaxationPath(True, step, ratio, history)
         v += (r - settings.damping * np.abs(r) * np.sign(v)) / mass

@@ -111,14 +111,14 @@ class PlasticSystem:
     def strain_increment(self, U: np.ndarray) -> np.ndarray:
         return (self.G @ (U - self.U)).reshape(-1, 4) @ FROM_GRAD.T
 
-    def trial_stress(self, material: MohrCoulomb, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return material.update(self.stress, self.strain_increment(U))
+    def trial_state(self, material: MohrCoulomb, U: np.ndarray) -> tuple[np.ndarray, ...]:
+        """(U, stress, region, plastic strain) at U from the committed state, laid out as a snapshot."""
+        de = self.strain_increment(U)
+        stress, region = material.update(self.stress, de)
+        return U.copy(), stress, region, self.plastic_strain + plastic_strain_increment(material, de, stress - self.stress)
 
     def commit(self, material: MohrCoulomb, U: np.ndarray) -> None:
-        de = self.strain_increment(U)
-        stress, self.region = material.update(self.stress, de)
-        self.plastic_strain += plastic_strain_increment(material, de, stress - self.stress)
-        self.stress, self.U = stress, U.copy()
+        self.U, self.stress, self.region, self.plastic_strain = self.trial_state(material, U)
 
     def external_force(self, load_factor: float) -> np.ndarray:
         return self.dead(load_factor) + load_factor * self.body
@@ -188,6 +188,11 @@ class PlasticSystem:
         self._clock("factorisation", t1 - t0)
         self._clock("substitution", time.perf_counter() - t1)
         return du
+
+    def iteration_counts(self) -> dict[str, Any]:
+        """Tangents built, factorisations and the seconds spent in each phase of the iterations."""
+        return {"tangents": self.tangents, "factorisations": self.factorisations,
+                "iteration_seconds": {k: round(v, 3) for k, v in self.seconds.items()}}
 
     def _clock(self, phase: str, seconds: float) -> None:
         self.seconds[phase] = self.seconds.get(phase, 0.0) + seconds
@@ -261,6 +266,10 @@ class PlasticOutput:
     counts: dict[str, Any]
     parameters: dict[str, Any]
 
+    def plastic_field(self, plastic_strain: np.ndarray) -> dict[str, np.ndarray]:
+        """Point data ``plastic_strain``: the equivalent plastic strain of (m, 4) point values, at the points."""
+        return {"plastic_strain": self.nodal(equivalent_plastic_strain(plastic_strain)[:, None])[:, 0]}
+
 
 def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, timer: Timer,
                       progress: Callable[[Any], None] = lambda level: None) -> Result:
@@ -270,12 +279,9 @@ def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, tim
     material = case.problem.material
     series: list[dict] = []
 
-    def plastic_field() -> dict[str, np.ndarray]:
-        return {"plastic_strain": out.nodal(equivalent_plastic_strain(system.plastic_strain)[:, None])[:, 0]}
-
     def on_converged(factor: float, U: np.ndarray) -> dict:
         series.append({"load_factor": factor, "u": out.displacement(U), "stress": out.nodal(system.stress[:, :3]),
-                       "fields": plastic_field()})
+                       "fields": out.plastic_field(system.plastic_strain)})
         record = {"plastic_points": int((system.region != ELASTIC).sum())}
         for name, rec in out.probe_values(U, None).items():
             record[name] = {k: rec[k] for k in ("x", "y", "ux", "uy")}
@@ -295,13 +301,11 @@ def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, tim
     timer.lap("solve")
     probes = out.probe_values(path.U, system.stress[:, :3])
     stress = out.nodal(system.stress[:, :3])
-    fields = plastic_field()
+    fields = out.plastic_field(system.plastic_strain)
     timer.lap("postprocess")
     counts = {**out.counts, "load_increments": sum(h["converged"] for h in path.history),
               "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
-              "tangents": system.tangents, "factorisations": system.factorisations,
-              "plastic_points": int((system.region != ELASTIC).sum()),
-              "iteration_seconds": {k: round(v, 3) for k, v in system.seconds.items()}}
+              "plastic_points": int((system.region != ELASTIC).sum()), **system.iteration_counts()}
     return Result(
         method=out.method, points=out.points, u=out.displacement(path.U), stress=stress, cells=out.cells,
         probes=probes, errors={}, counts=counts, timings=timer.total(), history=path.history, series=series,
@@ -320,7 +324,7 @@ def _relaxed(case: Case, system: PlasticSystem, out: PlasticOutput, timer: Timer
         probes=out.probe_values(system.U, stress), errors={},
         counts={**out.counts, "steps": path.steps, "plastic_points": int((system.region != ELASTIC).sum())},
         timings={}, history=path.history,
-        fields={"plastic_strain": out.nodal(equivalent_plastic_strain(system.plastic_strain)[:, None])[:, 0]},
+        fields=out.plastic_field(system.plastic_strain),
         outcome={"relaxation": {"at_rest": path.at_rest, "steps": path.steps, "residual": path.residual}},
         parameters=out.parameters, defaults=case.defaults)
     timer.lap("postprocess")

@@ -38,9 +38,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .dynamic_relaxation import Relaxation, relax
+from .dynamic_relaxation import Relaxation, max_displacement, relax
 from .errors import ProblemError
-from .mohr_coulomb import MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
+from .mohr_coulomb import MohrCoulomb
 from .result import Result
 
 SOLVERS = ("newton", "dynamic-relaxation")
@@ -98,14 +98,14 @@ class Level:
     stable: bool
     iterations: int
     cutbacks: int
-    max_displacement: float          # converged state, or the last iterate of a failed level
     seconds: float
+    state: tuple[np.ndarray, ...]    # (U, stress, region, plastic strain): converged, or a failed level's last iterate
     criterion: str = ""              # a failed level: why; a stable one: how it was reached, where not its own
-    state: tuple[np.ndarray, ...] | None = None    # system snapshot of a stable level
-    trial: np.ndarray | None = None                # last iterate of a failed level
-    plastic: np.ndarray | None = None              # equivalent plastic strain at the points (failed: last iterate)
-    stress: np.ndarray | None = None               # stress (m, 4) at the points (failed: last iterate)
     path: list[list[float]] | None = None          # dynamic relaxation: [step, max displacement] as it ran
+
+    @property
+    def max_displacement(self) -> float:
+        return max_displacement(self.state[0])
 
     def record(self) -> dict[str, Any]:
         return {"srf": self.srf, "stable": self.stable, "iterations": self.iterations, "cutbacks": self.cutbacks,
@@ -118,22 +118,15 @@ def _relax_level(system, relaxation: Relaxation, material: MohrCoulomb, srf: flo
     """Dynamic relaxation from the committed state with ``material`` under the full loads."""
     t0 = time.perf_counter()
     path = relax(system, material, 1.0, relaxation, fixed_values)
-    common = dict(plastic=equivalent_plastic_strain(system.plastic_strain), stress=system.stress.copy(),
-                  path=[[h["step"], h["max_displacement"]] for h in path.history])
+    history = [[h["step"], h["max_displacement"]] for h in path.history]
     seconds = time.perf_counter() - t0
     growth = path.growth()
     if path.at_rest or growth <= SETTLED_GROWTH:
         note = "" if path.at_rest else (f"not at rest (out-of-balance {path.residual:.1e}) but settled: the "
                                         f"displacement grew {100 * growth:.2g} % over the last quarter of the steps")
-        return Level(srf, True, path.steps, 0, _max_displacement(system.U), seconds, criterion=note,
-                     state=system.snapshot(), **common)
-    return Level(srf, False, path.steps, 0, _max_displacement(system.U), seconds,
-                 criterion=f"not at rest, still moving ({100 * growth:.2g} % over the last quarter)",
-                 trial=system.U.copy(), **common)
-
-
-def _max_displacement(U: np.ndarray) -> float:
-    return float(np.linalg.norm(U.reshape(-1, 2), axis=1).max())
+        return Level(srf, True, path.steps, 0, seconds, system.snapshot(), note, history)
+    return Level(srf, False, path.steps, 0, seconds, system.snapshot(),
+                 f"not at rest, still moving ({100 * growth:.2g} % over the last quarter)", history)
 
 
 def _level(system, loading, material_at, load_at, srf_at: Callable[[float], float], fixed_values=None
@@ -146,22 +139,14 @@ def _level(system, loading, material_at, load_at, srf_at: Callable[[float], floa
                       stop_on_failure=True)
     seconds = time.perf_counter() - t0
     if path.failed_at is None:
-        return Level(srf_at(1.0), True, path.newton_iterations, path.cutbacks, _max_displacement(system.U), seconds,
-                     state=system.snapshot(), plastic=equivalent_plastic_strain(system.plastic_strain),
-                     stress=system.stress.copy()), None
-    material = material_at(path.failed_at)
-    de = system.strain_increment(path.failed_trial)
-    trial_stress, _ = material.update(system.stress, de)
-    plastic = system.plastic_strain + plastic_strain_increment(material, de, trial_stress - system.stress)
-    failed = Level(srf_at(path.failed_at), False, path.newton_iterations, path.cutbacks,
-                   _max_displacement(path.failed_trial), seconds, criterion="non-convergence", trial=path.failed_trial,
-                   plastic=equivalent_plastic_strain(plastic), stress=trial_stress)
+        return Level(srf_at(1.0), True, path.newton_iterations, path.cutbacks, seconds, system.snapshot()), None
+    failed = Level(srf_at(path.failed_at), False, path.newton_iterations, path.cutbacks, seconds,
+                   system.trial_state(material_at(path.failed_at), path.failed_trial), "non-convergence")
     reached = [h["load_factor"] for h in path.history if h["converged"]]
     if not reached:
         return failed, None
-    return failed, Level(srf_at(reached[-1]), True, 0, 0, _max_displacement(system.U), 0.0, state=system.snapshot(),
-                         criterion="reached by the cut-back sub-steps of the next level",
-                         plastic=equivalent_plastic_strain(system.plastic_strain), stress=system.stress.copy())
+    return failed, Level(srf_at(reached[-1]), True, 0, 0, 0.0, system.snapshot(),
+                         "reached by the cut-back sub-steps of the next level")
 
 
 def gravity_level(system, loading, material: MohrCoulomb, srf: float, relaxation: Relaxation | None = None) -> Level:
@@ -240,7 +225,6 @@ def solve_strength_reduction(case, system, out, base: Result,
     """Run the ``[strength-reduction]`` of ``case`` on ``system`` (any discretisation, reported through
     ``out``, a :class:`ctmrpim.elastoplastic.PlasticOutput`) and fill ``base`` with the last stable
     state, the levels in the history and the series, and the factor of safety as a bracket."""
-    nodal = out.nodal
     settings: StrengthReduction = case.strength_reduction
     material = case.problem.material
     relaxation = case.relaxation if settings.solver == "dynamic-relaxation" else None
@@ -253,24 +237,22 @@ def solve_strength_reduction(case, system, out, base: Result,
     stable, failed = bracket(levels)
     series = []
     for lv in levels:
-        U = lv.state[0] if lv.stable else lv.trial
-        series.append({"time": lv.srf, "load_factor": 1.0, "u": out.displacement(U), "stress": nodal(lv.stress[:, :3]),
-                       "fields": {"plastic_strain": nodal(lv.plastic[:, None])[:, 0],
-                                  "stable": np.full(len(base.points), float(lv.stable))}})
+        U, stress, _, plastic = lv.state
+        series.append({"time": lv.srf, "load_factor": 1.0, "u": out.displacement(U), "stress": out.nodal(stress[:, :3]),
+                       "fields": {**out.plastic_field(plastic), "stable": np.full(len(base.points), float(lv.stable))}})
     last = next((lv for lv in reversed(levels) if lv.stable and lv.srf == stable), None)
     if last is not None:
-        base.u = out.displacement(last.state[0])
-        base.stress = nodal(last.state[1][:, :3])
-        base.probes = out.probe_values(last.state[0], last.state[1][:, :3])
-        base.fields = {"plastic_strain": nodal(last.plastic[:, None])[:, 0]}
+        U, stress, _, plastic = last.state
+        base.u = out.displacement(U)
+        base.stress = out.nodal(stress[:, :3])
+        base.probes = out.probe_values(U, stress[:, :3])
+        base.fields = out.plastic_field(plastic)
     base.history = [lv.record() for lv in levels]
     base.series = series
     base.outcome = {"factor_of_safety": {"stable": stable, "failed": failed, "criterion": CRITERION[settings.solver],
                                          "mode": "sweep" if settings.values else "search"}}
     base.counts.update(levels=len(levels), newton_iterations=sum(lv.iterations for lv in levels),
-                       cutbacks=sum(lv.cutbacks for lv in levels), tangents=system.tangents,
-                       factorisations=system.factorisations,
-                       iteration_seconds={k: round(v, 3) for k, v in system.seconds.items()})
+                       cutbacks=sum(lv.cutbacks for lv in levels), **system.iteration_counts())
     base.timings = {**base.timings, "strength_reduction": seconds,
                     "total": base.timings.get("total", 0.0) + seconds}
     return base

@@ -85,19 +85,19 @@ def solve_fem_elastoplastic(case: Case, element: str = "p2",
     probe_s = [scalar.probes(at) for at in probe_at]
     timer.lap("assembly")
 
+    def moments(space, values: np.ndarray) -> np.ndarray:
+        """(space.N, k): int f_k phi_i of point values f (m, k) against the functions of ``space``."""
+        v = values.reshape(nel, nq, -1)
+        return np.column_stack([LinearForm(lambda f, w_: w_.s * f).assemble(space, s=v[:, :, k])
+                                for k in range(v.shape[-1])])
+
     def projected(values: np.ndarray) -> np.ndarray:
         """(scalar.N, k) L2 projection of point values (m, k)."""
-        v = values.reshape(nel, nq, -1)
-        rhs = np.column_stack([LinearForm(lambda f, w_: w_.s * f).assemble(scalar, s=v[:, :, k])
-                               for k in range(v.shape[-1])])
-        return mass.solve(rhs)
+        return mass.solve(moments(scalar, values))
 
     def vertex_average(values: np.ndarray) -> np.ndarray:
         """(nvertices, k) lumped-mass average of point values (m, k) onto the vertices."""
-        v = values.reshape(nel, nq, -1)
-        rhs = np.column_stack([LinearForm(lambda f, w_: w_.s * f).assemble(hats, s=v[:, :, k])
-                               for k in range(v.shape[-1])])
-        return rhs / lumped[:, None]
+        return moments(hats, values) / lumped[:, None]
 
     def probe_values(U: np.ndarray, stress: np.ndarray | None) -> dict:
         s_dofs = projected(stress) if stress is not None else None

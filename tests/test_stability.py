@@ -110,7 +110,7 @@ def test_reduced_strength_follows_eqs_38_39() -> None:
 
 def test_bracket_takes_the_largest_stable_below_the_smallest_failed() -> None:
     from ctmrpim.strength_reduction import Level
-    levels = [Level(s, ok, 0, 0, 0.0, 0.0) for s, ok in [(1.0, True), (1.4, False), (1.3, True), (1.5, True)]]
+    levels = [Level(s, ok, 0, 0, 0.0, ()) for s, ok in [(1.0, True), (1.4, False), (1.3, True), (1.5, True)]]
     assert bracket(levels) == (1.3, 1.4)
     assert bracket(levels[:1]) == (1.0, None)
 
