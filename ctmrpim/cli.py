@@ -79,6 +79,22 @@ def describe(result: Result, case: Case) -> str:
                          f"(peak traction; "
                          f"load factor {result.outcome['limit_load_factor']['carried']:.5g} .. "
                          f"{result.outcome['limit_load_factor']['failed']:.5g})")
+    dyn = result.outcome.get("dynamics")
+    if dyn is not None:
+        e, dt = dyn["energy"], dyn["dt"]
+        rest = "at rest" if dyn["at_rest"] else "NOT at rest"
+        lines.append(f"  explicit dynamics: t = {dyn['end_time']:.4g} s ({rest}), "
+                     f"{dyn['steps']} steps (+{dyn['stage_steps']} in the gravity stage), dt {dt['min']:.3g} .. "
+                     f"{dt['max']:.3g} s, {dyn['rebuilds']} rebuilds ({dyn['state_transfers']} with new CTM points and "
+                     f"the state transferred; {dyn['returned_to_yield']} points returned to the yield surface), "
+                     f"{dyn['free_particles']['final']} free particle(s), "
+                     f"{dyn['points_without_shape_functions']} point(s) dropped")
+        lines.append(f"  energy: gravity work {e['gravity_work']:.4g} J = kinetic {e['kinetic']:.3g} + elastic change "
+                     f"{e['elastic'] - e['elastic_initial']:.3g} + plastic {e['plastic_dissipation']:.4g} + contact "
+                     f"{e['wall_dissipation']:.4g} + damping {e['damping_dissipation']:.3g} (transfers "
+                     f"{e['transfer_change']:.3g}; imbalance {100 * e['material_balance']:.2f} %)")
+        per = dyn["seconds_per_step"]
+        lines.append("  per step: " + ", ".join(f"{k.replace('_', ' ')} {1e3 * v:.2f} ms" for k, v in per.items()))
     if "load_increments" in c:
         line = (f"  {c['load_increments']} load increments, {c['newton_iterations']} Newton iterations, "
                 f"{c['cutbacks']} cut-back(s)")
@@ -119,14 +135,18 @@ def _description(name: str) -> str:
 
 def cmd_run(args: argparse.Namespace) -> int:
     case = load_target(args.target, args.set or [])
+    suffix = "" if args.solver == "ctm-rpim" else f"-fem-{args.element}"
+    out = Path(args.out) if args.out else Path("runs") / f"{case.problem.name}{suffix}"
+    if args.resume and case.problem.analysis != "explicit":
+        raise ProblemError("--resume continues an explicit dynamic run from its checkpoint; this analysis is "
+                           f"{case.problem.analysis!r}", key="--resume")
     try:
         progress = None if args.quiet else (lambda level: print("  " + _level_line(level.record()), file=sys.stderr,
                                                                     flush=True))
-        result = solve(case, args.solver, args.element, progress=progress)
+        result = solve(case, args.solver, args.element, progress=progress, out=out, resume=args.resume,
+                       progress_bar=not args.quiet)
     except ProblemError as exc:  # raised while solving, e.g. a selector that matches no node: name the file
         raise exc.at(source=case.source) from None
-    suffix = "" if args.solver == "ctm-rpim" else f"-fem-{args.element}"
-    out = Path(args.out) if args.out else Path("runs") / f"{case.problem.name}{suffix}"
     paths = write_outputs(result, case, out)
     if not args.quiet:
         print(describe(result, case))
@@ -182,7 +202,9 @@ def cmd_study(args: argparse.Namespace) -> int:
     sweep = _sweep(args)
     for name in names:
         df = studies.run(name, args.quick, Path(args.out), sweep)
-        print(df.drop(columns=[c for c in ("status",) if c in df]).to_string(index=False))
+        shown = df.drop(columns=[c for c in df if c == "status" or df[c].astype(str).str.startswith(("{", "[")).any()
+                                 or c == "folder"])      # curves and profiles (JSON) stay in the CSV
+        print(shown.to_string(index=False))
     return 0
 
 
@@ -214,6 +236,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--solver", choices=METHODS, default="ctm-rpim")
     p.add_argument("--element", choices=ELEMENTS, default="q1", help="FEM element (with --solver fem)")
     p.add_argument("--quiet", action="store_true", help="print nothing on success")
+    p.add_argument("--resume", action="store_true",
+                   help="explicit dynamics: continue from the checkpoint in the output folder")
     p.set_defaults(func=cmd_run)
     p = sub.add_parser("study", help="run a parameter study (tables and figures under reports/)")
     p.add_argument("name", help="study name, or all: node-density, integration-density, support-radius, "

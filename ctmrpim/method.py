@@ -35,6 +35,8 @@ class Method:
     formulation: str = "updated-lagrangian"  # quasi-static: the paper's adaptive one, or total-lagrangian
     point_regeneration: float = 0.0      # UL: lay new CTM points once a point is strained by more than
                                          # this since they were laid; 0 = every increment (the paper)
+    min_support: int = 0                 # explicit dynamics: widen a support holding fewer nodes than this to
+                                         # its min_support nearest (a thinning flow front); 0 = r_c alone
 
     def __post_init__(self) -> None:
         self.line_spacing = tuple(float(v) for v in self.line_spacing)
@@ -55,6 +57,8 @@ class Method:
             ("match_tolerance", 0 < self.match_tolerance < 0.5, "must lie in (0, 0.5)"),
             ("formulation", self.formulation in FORMULATIONS, f"must be one of {list(FORMULATIONS)}"),
             ("point_regeneration", self.point_regeneration >= 0, "must be >= 0 (0: every increment)"),
+            ("min_support", isinstance(self.min_support, int) and not isinstance(self.min_support, bool)
+             and self.min_support >= 0, "must be an integer >= 0 (0: off)"),
         ]
         for key, ok, why in checks:
             if not ok:

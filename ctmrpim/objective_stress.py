@@ -58,6 +58,14 @@ def hughes_winget(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return de, inv2(eye - half_w) @ (eye + half_w)
 
 
+def largest_strain(F: np.ndarray) -> float:
+    """Largest |principal stretch - 1| over deformation gradients (m, 2, 2)."""
+    C = F.transpose(0, 2, 1) @ F
+    mean, half = 0.5 * (C[:, 0, 0] + C[:, 1, 1]), np.hypot(0.5 * (C[:, 0, 0] - C[:, 1, 1]), C[:, 0, 1])
+    stretches = np.sqrt(np.c_[mean + half, np.maximum(mean - half, 0.0)])
+    return float(np.abs(stretches - 1.0).max()) if len(F) else 0.0
+
+
 def check_orientation(f: np.ndarray) -> np.ndarray:
     """det f, or a ProblemError naming the first point where the increment inverts the material."""
     J = det2(f.real)
@@ -162,3 +170,61 @@ def complex_step_tangent(update, f: np.ndarray, state: np.ndarray) -> np.ndarray
         A[:, :, k] = update.first_piola(fc, state).reshape(m, 4).imag / COMPLEX_STEP
         fc[:, i, J] = f[:, i, J]
     return A
+
+
+# -- component forms for the explicit solver's step -------------------------------------------------
+# The explicit solver updates tens of thousands of points every step; numpy's batched 2 x 2 matmul is
+# slow for such small matrices, so its step writes the same algebra out in components. A gradient is
+# stored (m, 4) as xx, xy, yx, yy (F[:, 1] = dx/dY); a stress or strain tensor (m, 4) as xx, yy, xy, zz.
+# tests/test_explicit_dynamics.py checks each against the matrix forms above.
+
+def det_c(F: np.ndarray) -> np.ndarray:
+    return F[:, 0] * F[:, 3] - F[:, 1] * F[:, 2]
+
+
+def first_piola_c(stress: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """(m, 4) P = det F sigma F^-T (xX, xY, yX, yY) of Cauchy stresses (m, 4) at gradients F (m, 4)."""
+    sxx, syy, sxy = stress[:, 0], stress[:, 1], stress[:, 2]
+    F00, F01, F10, F11 = F.T
+    return np.stack([sxx * F11 - sxy * F01, sxy * F00 - sxx * F10,
+                     sxy * F11 - syy * F01, syy * F00 - sxy * F10], axis=1)
+
+
+def relative_c(F_new: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """(m, 4) f = F_new F^-1."""
+    J = det_c(F)
+    a00, a01, a10, a11 = F_new.T
+    i00, i01, i10, i11 = F[:, 3] / J, -F[:, 1] / J, -F[:, 2] / J, F[:, 0] / J
+    return np.stack([a00 * i00 + a01 * i10, a00 * i01 + a01 * i11, a10 * i00 + a11 * i10, a10 * i01 + a11 * i11], axis=1)
+
+
+def hughes_winget_c(f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The strain increment (m, 3: exx, eyy, engineering gxy) and the rotation Q = [[c, -s], [s, c]]
+    (c, s) of :func:`hughes_winget`: G = L (I + L/2)^-1, Q = (I - W/2)^-1 (I + W/2) with W = skew G."""
+    L00, L01, L10, L11 = f[:, 0] - 1.0, f[:, 1], f[:, 2], f[:, 3] - 1.0
+    A00, A01, A10, A11 = 1.0 + 0.5 * L00, 0.5 * L01, 0.5 * L10, 1.0 + 0.5 * L11
+    det = A00 * A11 - A01 * A10
+    G00 = (L00 * A11 - L01 * A10) / det
+    G01 = (L01 * A00 - L00 * A01) / det
+    G10 = (L10 * A11 - L11 * A10) / det
+    G11 = (L11 * A00 - L10 * A01) / det
+    h = 0.25 * (G01 - G10)                 # W/2 = [[0, h], [-h, 0]]
+    scale = 1.0 / (1.0 + h * h)
+    return np.stack([G00, G11, G01 + G10], axis=1), (1.0 - h * h) * scale, -2.0 * h * scale
+
+
+def rotate_c(state: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Q t Q^T of tensors (m, 4: xx, yy, xy, zz) for Q = [[c, -s], [s, c]]; zz unchanged."""
+    xx, yy, xy = state[:, 0], state[:, 1], state[:, 2]
+    cc, ss, cs = c * c, s * s, c * s
+    return np.stack([cc * xx - 2.0 * cs * xy + ss * yy, ss * xx + 2.0 * cs * xy + cc * yy,
+                     cs * (xx - yy) + (cc - ss) * xy, state[:, 3]], axis=1)
+
+
+def largest_strain_c(F: np.ndarray) -> float:
+    """:func:`largest_strain` of gradients (m, 4)."""
+    C00, C11 = F[:, 0] ** 2 + F[:, 2] ** 2, F[:, 1] ** 2 + F[:, 3] ** 2
+    C01 = F[:, 0] * F[:, 1] + F[:, 2] * F[:, 3]
+    mean, half = 0.5 * (C00 + C11), np.hypot(0.5 * (C00 - C11), C01)
+    big, small = np.sqrt(mean + half), np.sqrt(np.maximum(mean - half, 0.0))
+    return float(max(np.abs(big - 1.0).max(), np.abs(small - 1.0).max())) if len(F) else 0.0

@@ -100,17 +100,50 @@ def write_series(result: Result, out_dir: Path) -> list[Path]:
     if not result.series:
         return []
     out_dir = Path(out_dir)
-    entries, written = [], []
+    entries: list[tuple[float, str]] = []
+    written = []
     for k, step in enumerate(result.series, start=1):
         name = f"series/step_{k:04d}.vtu"
         mesh = _mesh(result, step["u"], step["stress"], moved=True, boundary=step.get("boundary"),
                      fields=step.get("fields"))
         atomic_write(out_dir / name, lambda p, m=mesh: meshio.write(p, m, file_format="vtu"))
         written.append(out_dir / name)
-        time = step["time"] if "time" in step else step["load_factor"]   # a strength reduction: the SRF
-        entries.append(f'    <DataSet timestep="{time:.10g}" part="0" file="{name}"/>')
-    pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
-           "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
-    atomic_write_text(out_dir / "result.pvd", pvd)
+        entries.append((step["time"] if "time" in step else step["load_factor"], name))  # strength reduction: SRF
+    atomic_write_text(out_dir / "result.pvd", pvd_text(entries))
     return written + [out_dir / "result.pvd"]
+
+
+def pvd_text(entries: list[tuple[float, str]]) -> str:
+    """A ParaView collection (``.pvd``) of (time, file) entries."""
+    lines = "\n".join(f'    <DataSet timestep="{t:.10g}" part="0" file="{name}"/>' for t, name in entries)
+    return ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
+            "  <Collection>\n" + lines + "\n  </Collection>\n</VTKFile>\n")
+
+
+def read_pvd(path: Path) -> list[tuple[float, Path]]:
+    """(time, file) of each state of a ``.pvd`` index, the files as paths beside the index."""
+    import xml.etree.ElementTree as ET
+    path = Path(path)
+    return [(float(d.get("timestep")), path.parent / d.get("file")) for d in ET.parse(path).iter("DataSet")]
+
+
+class SeriesWriter:
+    """A time series written as a run goes: ``series/step_NNNNN.vtu`` per saved state and ``result.pvd``
+    rewritten (atomically) after each, so that ParaView can open a run that is still going, and a
+    resumed run continues the same index (``entries`` come back from its checkpoint)."""
+
+    def __init__(self, out_dir: Path, entries: list[tuple[float, str]] | None = None) -> None:
+        self.out_dir = Path(out_dir)
+        self.entries = [(float(t), str(f)) for t, f in (entries or [])]
+
+    def add(self, time: float, points: np.ndarray, cells: list[tuple[str, np.ndarray]],
+            point_data: dict[str, np.ndarray]) -> Path:
+        n = len(points)
+        name = f"series/step_{len(self.entries):05d}.vtu"
+        mesh = meshio.Mesh(np.c_[points, np.zeros(n)], [("vertex", np.arange(n).reshape(-1, 1)), *cells],
+                           point_data=point_data)
+        atomic_write(self.out_dir / name, lambda p: meshio.write(p, mesh, file_format="vtu"))
+        self.entries.append((float(time), name))
+        atomic_write_text(self.out_dir / "result.pvd", pvd_text(self.entries))
+        return self.out_dir / name
 

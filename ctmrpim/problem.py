@@ -103,6 +103,7 @@ class Problem:
     pressures: list[Pressure] = field(default_factory=list)
     probes: list[Probe] = field(default_factory=list)
     point_loads: list[PointLoad] = field(default_factory=list)
+    walls: list = field(default_factory=list)     # rigid walls of explicit dynamics (ctmrpim.walls.Wall)
     exact: ExactSolution | None = None
 
     def D(self) -> np.ndarray:

@@ -26,8 +26,10 @@ from .mohr_coulomb import MohrCoulomb
 from .method import Method
 from .nodes import NodeSpec
 from .dynamic_relaxation import Relaxation
+from .explicit_settings import Explicit
 from .strength_reduction import StrengthReduction
 from .problem import Constraint, ExactSolution, PointLoad, Pressure, Probe, Problem, Traction
+from .walls import NO_SLIP, Wall
 
 SECTIONS: dict[str, set[str] | None] = {
     "problem": {"name", "analysis", "plane", "thickness", "description", "gravity"},
@@ -45,19 +47,22 @@ SECTIONS: dict[str, set[str] | None] = {
     "loading": {"steps", "tolerance", "max_iterations", "max_cutbacks", "tangent", "until_failure"},
     "strength-reduction": {"solver", "start", "step", "width", "max_srf", "steps", "values"},
     "dynamic": {"steps", "damping", "tolerance", "record_every"},
+    "explicit": set(Explicit.__dataclass_fields__),
+    "wall": {"name", "point", "normal", "friction", "gate"},
 }
-LIST_SECTIONS = {"constraint", "traction", "pressure", "probe", "point_load"}
+LIST_SECTIONS = {"constraint", "traction", "pressure", "probe", "point_load", "wall"}
 REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E", "nu"],
             "constraint": ["where"], "traction": ["where"], "pressure": ["where", "p"],
-            "probe": ["name", "at"], "point_load": ["at"]}
+            "probe": ["name", "at"], "point_load": ["at"], "wall": ["name", "point", "normal"]}
 #: Names people reach for instead of the file's keys, to suggest where difflib finds no close spelling.
 SYNONYMS = {"youngs": "E", "young": "E", "youngs_modulus": "E", "young_modulus": "E", "modulus": "E",
             "poisson": "nu", "poissons_ratio": "nu", "poisson_ratio": "nu", "rho": "density"}
-ANALYSES = ("linear", "quasi-static", "strength-reduction", "dynamic")
+ANALYSES = ("linear", "quasi-static", "strength-reduction", "dynamic", "explicit")
 MATERIAL_MODELS = ("linear-elastic", "neo-hookean", "mohr-coulomb")
 #: the material models each analysis solves (quasi-static linear-elastic: the updated-Lagrangian rate form)
 ANALYSIS_MODELS = {"linear": ("linear-elastic",), "quasi-static": ("neo-hookean", "linear-elastic", "mohr-coulomb"),
-                   "strength-reduction": ("mohr-coulomb",), "dynamic": ("mohr-coulomb",)}
+                   "strength-reduction": ("mohr-coulomb",), "dynamic": ("mohr-coulomb",),
+                   "explicit": ("mohr-coulomb",)}
 
 
 @dataclass(frozen=True)
@@ -99,6 +104,7 @@ class Case:
     loading: Loading = field(default_factory=Loading)
     strength_reduction: StrengthReduction | None = None
     relaxation: Relaxation | None = None          # [dynamic]: dynamic relaxation settings
+    explicit: Explicit | None = None              # [explicit]: explicit dynamics settings
 
 
 def load_case(path: str | Path, overrides: list[str] | None = None) -> Case:
@@ -244,6 +250,17 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         raise ProblemError("[dynamic] needs analysis = \"dynamic\" or strength-reduction.solver = "
                            "\"dynamic-relaxation\"", key="dynamic")
     relaxation = settings(Relaxation, "dynamic", dyn_raw, ("damping", "tolerance")) if uses_relaxation else None
+    ex_raw = raw.get("explicit")
+    if ex_raw is not None and analysis != "explicit":
+        raise ProblemError("[explicit] needs analysis = \"explicit\"", key="explicit")
+    explicit = None
+    if analysis == "explicit":
+        if "dt" in (ex_raw or {}) and ex_raw["dt"] != "cfl":
+            ex_raw = {**ex_raw, "dt": num(ex_raw["dt"], "explicit.dt")}
+        explicit = settings(Explicit, "explicit", ex_raw, ("duration", "cfl", "damping", "rebuild_strain", "relay_strain", "area_jump",
+                                                           "save_every", "rest", "stage_damping", "stage_tolerance"))
+    if raw.get("wall") and analysis != "explicit":
+        raise ProblemError("[[wall]] (rigid contact) needs analysis = \"explicit\"", key="wall")
     if loading.tangent == "elastic" and mat["model"] != "mohr-coulomb":
         raise ProblemError("tangent = \"elastic\" is the Mohr-Coulomb solver's iteration; large-deformation "
                            "solvers use the consistent tangent", key="loading.tangent")
@@ -306,13 +323,30 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     if "exact" in raw:
         exact = ExactSolution(**{k: fld(v, f"exact.{k}") for k, v in raw["exact"].items()})
 
-    if not constraints:
+    walls = []
+    for i, c in enumerate(raw.get("wall", [])):
+        friction = c.get("friction", NO_SLIP)
+        if friction != NO_SLIP:
+            friction = num(friction, f"wall[{i}].friction")
+        gate = c.get("gate", False)
+        if not isinstance(gate, bool):
+            raise ProblemError(f"{gate!r} must be true or false", key=f"wall[{i}].gate")
+        vectors = []
+        for k in ("point", "normal"):
+            if not isinstance(c[k], list) or len(c[k]) != 2:
+                raise ProblemError(f"{c[k]!r} must be [x, y]", key=f"wall[{i}].{k}")
+            vectors.append(tuple(num(v, f"wall[{i}].{k}") for v in c[k]))
+        try:
+            walls.append(Wall(str(c["name"]), *vectors, friction=friction, gate=gate))
+        except ProblemError as exc:
+            raise ProblemError(exc.reason, key=f"wall[{i}]") from None
+    if not constraints and not (analysis == "explicit" and walls):
         raise ProblemError("no [[constraint]]: the body is free to move rigidly", key="constraint")
 
     problem = Problem(name=str(prob["name"]), geometry=geometry, material=material, analysis=analysis,
                       plane=plane, thickness=thickness, gravity=gravity, parameters=params, constraints=constraints,
                       tractions=tractions, pressures=pressures, probes=probes, exact=exact,
-                      point_loads=point_loads)
+                      point_loads=point_loads, walls=walls)
 
     nodes_raw = raw.get("nodes")
     if not nodes_raw:
@@ -366,11 +400,14 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
         resolved["loading"] = asdict(loading)
     if relaxation is not None:
         resolved["dynamic"] = asdict(relaxation)
+    if explicit is not None:
+        resolved["explicit"] = asdict(explicit)
+        resolved["wall"] = [asdict(w) for w in walls]
     if strength_reduction is not None:
         resolved["strength-reduction"] = {**asdict(strength_reduction), "values": list(strength_reduction.values)}
     return Case(problem=problem, nodes=nodes, method=method, source=source, base_dir=base_dir,
                 resolved=resolved, defaults=defaults, loading=loading, strength_reduction=strength_reduction,
-                relaxation=relaxation)
+                relaxation=relaxation, explicit=explicit)
 
 
 def _grid(value: Any, num) -> tuple[int, int]:

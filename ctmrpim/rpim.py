@@ -36,6 +36,7 @@ class ShapeFunctions:
     dNdx: sp.csr_matrix     # (m, n) x derivatives
     dNdy: sp.csr_matrix     # (m, n) y derivatives
     support_sizes: np.ndarray  # (m,) nodes in each point's support
+    dropped: np.ndarray | None = None   # points left without shape functions (``drop_singular``)
 
 
 def _powr(r2: np.ndarray, p: float) -> np.ndarray:
@@ -65,7 +66,8 @@ def _polynomial(x: np.ndarray, y: np.ndarray, m: int) -> np.ndarray:
 def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float, eta: float,
                     polynomial_terms: int, scale: float, derivatives: bool = True,
                     tree: cKDTree | None = None,
-                    reference: tuple[np.ndarray, np.ndarray, float] | None = None) -> ShapeFunctions:
+                    reference: tuple[np.ndarray, np.ndarray, float] | None = None,
+                    min_nodes: int = 0, drop_singular: bool = False) -> ShapeFunctions:
     """RPIM shape functions (Eqs. 25-34) of ``nodes`` at ``points``.
 
     ``support_radius`` and ``scale`` (d_c) are absolute lengths. A point whose support holds fewer
@@ -73,13 +75,22 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
     ``reference = (node_positions, point_positions, distance)`` on a deformed cloud drops from a
     support every node farther than ``distance`` from the point in the reference configuration, so
     that parts of the body that were far apart (the two ends of a beam rolled into a ring) never
-    share shape functions when they come close.
+    share shape functions when they come close. ``min_nodes`` > 0 widens the support of a point that
+    holds fewer nodes than that to its ``min_nodes`` nearest (a flow front, where the cloud thins out:
+    r^eta with eta = 5 is conditionally positive definite of order 3, so with the linear basis a
+    support of a handful of scattered nodes can make the moment matrix singular).
     """
     nodes = np.asarray(nodes, float)
     points = np.asarray(points, float)
     m = polynomial_terms
     tree = tree or cKDTree(nodes)
     counts = tree.query_ball_point(points, support_radius, return_length=True)
+    radius = np.full(len(points), float(support_radius))
+    short = counts < min_nodes
+    if short.any() and min_nodes <= len(nodes):
+        far = tree.query(points[short], k=min_nodes)[0].reshape(-1, min_nodes)[:, -1]
+        radius[short] = far * (1.0 + 1e-12)
+        counts[short] = tree.query_ball_point(points[short], radius[short], return_length=True)
     need = m + 1
     if len(points) and counts.min() < need:
         i = int(np.argmin(counts))
@@ -96,8 +107,8 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
     def work(ab):
         sel = order[ab[0]:ab[1]]
         ref = None if reference is None else (reference[0], reference[1][sel], reference[2])
-        return _chunk(nodes, points[sel], sel, tree, int(counts[sel].max()), support_radius, eta, m, scale,
-                      derivatives, ref)
+        return _chunk(nodes, points[sel], sel, tree, int(counts[sel].max()), radius[sel], eta, m, scale,
+                      derivatives, ref, drop_singular)
 
     # each small LAPACK solve runs on one thread; BLAS threads on top of ours would only contend
     with threadpool_limits(limits=1, user_api="blas"):
@@ -124,14 +135,16 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
     mats = [sp.csr_matrix((values[j][gather], indices, indptr), shape=shape) for j in range(n_out)]
     if not derivatives:
         mats += [None, None]
-    return ShapeFunctions(N=mats[0], dNdx=mats[1], dNdy=mats[2], support_sizes=counts)
+    return ShapeFunctions(N=mats[0], dNdx=mats[1], dNdy=mats[2], support_sizes=counts,
+                          dropped=np.flatnonzero(counts == 0) if drop_singular else None)
 
 
-def _chunk(nodes, pts, point_ids, tree, k, radius, eta, m, scale, derivatives, reference=None):
-    dist, idx = tree.query(pts, k=k, distance_upper_bound=radius)
+def _chunk(nodes, pts, point_ids, tree, k, radius, eta, m, scale, derivatives, reference=None, drop=False):
+    """``radius`` (c,): each point's support radius."""
+    dist, idx = tree.query(pts, k=k, distance_upper_bound=float(radius.max()))
     dist = dist.reshape(len(pts), k)
     idx = idx.reshape(len(pts), k)
-    valid = np.isfinite(dist)
+    valid = dist <= radius[:, None]
     if reference is not None:
         node_ref, point_ref, far = reference
         gap = node_ref[np.where(valid, idx, 0)] - point_ref[:, None, :]
@@ -184,26 +197,39 @@ def _chunk(nodes, pts, point_ids, tree, k, radius, eta, m, scale, derivatives, r
     try:
         phi = np.linalg.solve(G, rhs)[:, :k, :]
     except np.linalg.LinAlgError:
-        raise _singular_error(pts, point_ids, _first_singular(G)) from None
-    bad = ~np.isfinite(phi).all(axis=(1, 2))
+        if not drop:
+            raise _singular_error(pts, point_ids, _first_singular(G)) from None
+        singular = _singular(G)
+        G[singular] = np.eye(size)
+        phi = np.linalg.solve(G, rhs)[:, :k, :]
+        phi[singular] = np.nan
+    with np.errstate(invalid="ignore"):
+        pu = np.abs((phi[..., 0] * vf).sum(axis=1) - 1.0)
+    bad = ~np.isfinite(phi).all(axis=(1, 2)) | ~(pu <= PARTITION_OF_UNITY_TOL)
     if bad.any():
-        raise _singular_error(pts, point_ids, int(np.flatnonzero(bad)[0]))
-    pu = np.abs((phi[..., 0] * vf).sum(axis=1) - 1.0)
-    if pu.max() > PARTITION_OF_UNITY_TOL:
-        raise _singular_error(pts, point_ids, int(np.argmax(pu)))
+        if not drop:
+            i = int(np.flatnonzero(bad)[0])
+            raise _singular_error(pts, point_ids, i)
+        valid[bad] = False
     vals = np.moveaxis(phi, 2, 0)[:, valid]                       # (n_out, nnz), row-major
     if derivatives:
         vals[1:] /= scale
     return idx[valid], vals, valid.sum(axis=1)
 
 
-def _first_singular(G: np.ndarray) -> int:
-    for i in range(len(G)):
+def _singular(G: np.ndarray) -> np.ndarray:
+    """(c,) bool: which of the matrices (c, s, s) LAPACK cannot factorise."""
+    out = np.zeros(len(G), bool)
+    for i in range(len(G)):   # only after a batched solve failed: rare
         try:
             np.linalg.solve(G[i], np.ones(len(G[i])))
         except np.linalg.LinAlgError:
-            return i
-    return 0
+            out[i] = True
+    return out
+
+
+def _first_singular(G: np.ndarray) -> int:
+    return int(np.argmax(_singular(G)))
 
 
 def _singular_error(pts: np.ndarray, point_ids: np.ndarray, i: int) -> ProblemError:

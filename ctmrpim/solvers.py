@@ -1,6 +1,7 @@
 """One entry point for every method that solves a Case: CTM-RPIM or the scikit-fem reference."""
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any, Callable
 
 from .problem_file import Case
@@ -11,10 +12,24 @@ ELEMENTS = ("q1", "p1", "p2")
 
 
 def solve(case: Case, solver: str = "ctm-rpim", element: str = "q1",
-          progress: Callable[[Any], None] | None = None) -> Result:
+          progress: Callable[[Any], None] | None = None, out: Path | None = None, resume: bool = False,
+          progress_bar: bool = False) -> Result:
     """Solve ``case`` with CTM-RPIM, or with scikit-fem ``element`` when ``solver == "fem"``;
-    ``progress`` gets each strength-reduction level as it finishes."""
+    ``progress`` gets each strength-reduction level as it finishes. An explicit dynamic run writes its
+    time series and checkpoints into ``out`` as it goes (a temporary folder if None), continues from
+    the checkpoint there with ``resume``, and shows a progress bar with ``progress_bar``."""
     progress = progress or (lambda level: None)
+    if case.problem.analysis == "explicit":
+        if solver == "fem":
+            from .errors import ProblemError
+            raise ProblemError("the FEM reference has no explicit dynamic solver (the column collapse is "
+                               "CTM-RPIM's alone)", key="--solver")
+        from .explicit_dynamics import solve_explicit
+        if out is None:
+            import tempfile
+            with tempfile.TemporaryDirectory() as tmp:
+                return solve_explicit(case, Path(tmp), resume, progress_bar)
+        return solve_explicit(case, out, resume, progress_bar)
     if solver == "fem":
         from .mohr_coulomb import MohrCoulomb
         if isinstance(case.problem.material, MohrCoulomb):

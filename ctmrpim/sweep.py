@@ -113,7 +113,8 @@ def run_case(spec: CaseSpec, folder: str, key: str, worker: bool = True) -> dict
     try:
         case = load_target(spec.target, list(spec.overrides))
         with threadpool_limits(1):
-            result = solve(case, spec.solver, spec.element)
+            result = solve(case, spec.solver, spec.element, out=folder_path,   # explicit runs: series, checkpoints
+                           resume=(folder_path / "checkpoint.npz").is_file())
         write_summary(result, folder_path, case.source)
         status.update(status="ok")
     except ProblemError as exc:

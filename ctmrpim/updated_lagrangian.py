@@ -50,7 +50,7 @@ from .linear_static import Configuration, Timer, build_configuration
 from .load_stepping import step_loads
 from .material import LinearElastic
 from .objective_stress import (HypoelasticUpdate, LeftCauchyGreenUpdate, check_orientation, complex_step_tangent,
-                               det2, inv2)
+                               det2, inv2, largest_strain)
 from .problem_file import Case
 from .result import Result, probe_record
 from .rpim import shape_functions
@@ -238,7 +238,7 @@ class AdaptiveBody:
         self.timer.lap("solve")
         skipped = None
         if rebuild:
-            regenerate = self.regeneration == 0.0 or _largest_strain(strained) > self.regeneration
+            regenerate = self.regeneration == 0.0 or largest_strain(strained) > self.regeneration
             try:
                 self._build(None if regenerate else (moved, w_moved, self.points_X))
             except ProblemError as err:
@@ -278,14 +278,6 @@ class AdaptiveBody:
 
     def stress_nodes(self) -> np.ndarray:
         return self.update.cauchy(self.nodal_state)
-
-
-def _largest_strain(F: np.ndarray) -> float:
-    """Largest |principal stretch - 1| over deformation gradients (m, 2, 2)."""
-    C = F.transpose(0, 2, 1) @ F
-    mean, half = 0.5 * (C[:, 0, 0] + C[:, 1, 1]), np.hypot(0.5 * (C[:, 0, 0] - C[:, 1, 1]), C[:, 0, 1])
-    stretches = np.sqrt(np.c_[mean + half, np.maximum(mean - half, 0.0)])
-    return float(np.abs(stretches - 1.0).max()) if len(F) else 0.0
 
 
 def _traction_tags(conf, thickness: float) -> TractionTags:

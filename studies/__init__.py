@@ -13,7 +13,8 @@ import pandas as pd
 
 NAMES = ["node_density", "integration_density", "support_radius", "shape_parameter", "parameter_map",
          "time_to_accuracy", "plate_hole_convergence", "tip_load", "end_moment", "slope_stability",
-         "slope_srf_sweep", "slope_relaxation", "footing_bearing"]
+         "slope_srf_sweep", "slope_relaxation", "footing_bearing", "slope_slide", "column_collapse",
+         "column_collapse_settings"]
 #: command-line spelling (dashes) -> module name
 ALIASES = {n.replace("_", "-"): n for n in NAMES}
 

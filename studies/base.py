@@ -2,10 +2,12 @@
 
 A study module defines ``NAME``, ``TITLE``, ``specs(quick) -> list[CaseSpec]`` (each spec labelled
 with the study's coordinates), ``figure(table) -> Figure`` and optionally ``extra(summary) -> dict``
-for columns of its own; :func:`run_study` (or ``studies.run(name)``) does the rest.
+for columns of its own (``extra(summary, folder)`` where it also reads the files a case wrote into its
+folder, such as an explicit run's time series); :func:`run_study` (or ``studies.run(name)``) does the rest.
 """
 from __future__ import annotations
 
+import inspect
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -40,7 +42,7 @@ def metrics(outcome: CaseOutcome, extra=None) -> dict[str, Any]:
                tip_error=tip.get("uy"), l2_error=errors.get("l2"), energy_error=errors.get("energy"),
                time_s=s["timings"]["total"])
     if extra is not None:
-        row.update(extra(s))
+        row.update(extra(s, outcome.folder) if len(inspect.signature(extra).parameters) == 2 else extra(s))
     return row
 
 

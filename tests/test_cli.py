@@ -75,7 +75,8 @@ def test_summary_holds_the_resolved_input(run) -> None:
     assert p["material"] == {"model": "linear-elastic", "E": 3.0e7, "nu": 0.3, "density": 1.0}
     assert p["method"] == {"support_radius": 4.0, "eta": 5.0, "polynomial": "linear", "line_spacing": [1 / 3, 1 / 3],
                            "gauss_points": 1, "alpha": 1.5, "boundary": "alpha", "solver": "auto",
-                           "match_tolerance": 0.01, "formulation": "updated-lagrangian", "point_regeneration": 0.0}
+                           "match_tolerance": 0.01, "formulation": "updated-lagrangian", "point_regeneration": 0.0,
+                           "min_support": 0}
     assert p["constraint"][0]["where"] == "x == 0" and p["traction"][0]["where"] == "x == L"
     assert p["probe"] == [{"name": "tip", "at": [48.0, 0.0]}, {"name": "root_top", "at": [0.0, 6.0]}]
     d_c = math.sqrt(48.0 * 12.0) / math.sqrt(297 - 1)       # Eq. (36)
@@ -84,7 +85,7 @@ def test_summary_holds_the_resolved_input(run) -> None:
     # the defaults that were applied are listed
     assert s["defaults_applied"] == ["problem.gravity = [0.0, 0.0]", "method.boundary = 'alpha'", "method.solver = 'auto'",
                                      "method.match_tolerance = 0.01", "method.formulation = 'updated-lagrangian'",
-                                     "method.point_regeneration = 0.0"]
+                                     "method.point_regeneration = 0.0", "method.min_support = 0"]
 
 
 def test_summary_counts_timings_probes_errors(run, api) -> None:

@@ -26,3 +26,9 @@ def path(name: str) -> Path:
 
 def load(name: str, overrides: list[str] | None = None) -> Case:
     return load_case(path(name), overrides)
+
+
+def data(folder: str, name: str):
+    """(k, 2) the measured points of ``data/FOLDER/NAME.csv`` (the folder's README gives the source)."""
+    import numpy as np
+    return np.loadtxt(FOLDER / "data" / folder / f"{name}.csv", delimiter=",", skiprows=1, ndmin=2)
