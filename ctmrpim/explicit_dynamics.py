@@ -561,7 +561,7 @@ class ExplicitRun:
         balance = e.gravity + e.damping + e.walls - e.internal - ke
         material_error = e.internal - (elastic - e.elastic0 + e.plastic - e.transfer)
         timings = self.timer.total()
-        steps = max(self.step, 1)
+        steps = max(self.step + self.stage_steps, 1)
         dynamics = {
             "end_time": self.t, "steps": self.step, "stage_steps": self.stage_steps, "at_rest": self.at_rest,
             "dt": {"first": self.history[0]["dt"] if self.history else self.dt, "min": self.dt_range[0],

@@ -52,8 +52,8 @@ def extra(summary: dict, folder) -> dict:
     edges = np.concatenate([c.data for c in m.cells if c.type == "line"])
     xs = np.arange(0.0, 0.5, 0.002)
     h = surface_profile(m.points[:, :2], edges, xs)
-    return {**row, "early_time_s": t, "early_front_m": column_collapse.run_out(xs, h, column_collapse.RUN_OUT_THICKNESS),
-            "early_profile": json.dumps(h.round(6).tolist())}
+    front = column_collapse.run_out(xs, h, column_collapse.RUN_OUT_THICKNESS)
+    return {**row, "early_time_s": t, "early_front_m": front, "early_profile": json.dumps(h.round(6).tolist())}
 
 
 def early_differences(df: pd.DataFrame) -> pd.DataFrame:
