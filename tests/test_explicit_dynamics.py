@@ -304,3 +304,22 @@ def test_a_node_thrown_off_the_body_is_free_or_stops_the_run(tmp_path):
     strict = ExplicitRun(benchmarks.load("column-collapse", QUICK + ["explicit.detached=\"stop\""]), tmp_path, "key")
     with pytest.raises(ProblemError, match="left the body"):
         strict.lay_frame(x, np.zeros(len(x), bool))
+
+
+def test_a_failed_re_tracking_falls_back_to_the_carried_points(tmp_path):
+    """Where the alpha shape cannot be traced (a pinch it cannot split), the run goes on with the points
+    it carried and tries again at the next rebuild; the failures are counted."""
+    case = benchmarks.load("column-collapse", QUICK + ["explicit.initial=\"none\"", "explicit.duration=0.03",
+                                                       "explicit.rebuild_strain=0.01", "explicit.relay_strain=0.01",
+                                                       "explicit.save_every=1.0"])
+    run = ExplicitRun(case, tmp_path, "key")
+    run.start()
+
+    def untraceable(x, free):
+        raise ProblemError("alpha shape: loop is not simple at node(s) [1]")
+
+    run.lay_frame = untraceable
+    run.run(progress=False)
+    assert run.rebuilds > 0 and run.relay_failures == run.rebuilds and run.transfers == 0
+    assert "not simple" in run.relay_failure
+    assert np.isfinite(run.x).all()

@@ -89,14 +89,27 @@ def test_plastic_flow_follows_the_dilatancy_angle(mat: MohrCoulomb, seed: int) -
     assert region.max() <= APEX
 
 
+def _tension_planes(mat: MohrCoulomb, stress: np.ndarray) -> np.ndarray:
+    """How many principal stresses sit on the tension cut-off: which tension planes are active (the
+    region code is TENSION for every active set of the multi-surface return)."""
+    if mat.tension is None:
+        return np.zeros(len(stress), int)
+    p = _principal(stress)[0]
+    tol = 1e-9 * (mat.c + np.abs(p).max(axis=1))
+    return (np.abs(p - mat.tension) <= tol[:, None]).sum(axis=1)
+
+
 def tangent_against_differences(mat: MohrCoulomb, stress: np.ndarray, de: np.ndarray):
     """The consistent tangent, its largest difference from central differences (step 1e-8) per point,
-    where no point switched region inside the stencil, and the regions."""
+    where no point switched region (or set of active tension planes) inside the stencil, and the
+    regions. (Measured: a point 0.04 Pa below a second tension plane crosses it with steps >= 1e-9 and
+    gives a 50 % difference; with 1e-10 the same point agrees to 6e-10.)"""
     T = mat.tangent(stress, de)
     h = 1e-8
     fd = np.empty_like(T)
     same = np.ones(len(de), bool)
-    _, region = mat.update(stress, de)
+    out, region = mat.update(stress, de)
+    planes = _tension_planes(mat, out)
     for k in range(3):
         dp, dm = de.copy(), de.copy()
         dp[:, k] += h
@@ -104,6 +117,7 @@ def tangent_against_differences(mat: MohrCoulomb, stress: np.ndarray, de: np.nda
         (sp_, rp), (sm_, rm) = mat.update(stress, dp), mat.update(stress, dm)
         fd[:, :, k] = (sp_[:, :3] - sm_[:, :3]) / (2 * h)
         same &= (rp == region) & (rm == region)                   # no region switch inside the stencil
+        same &= (_tension_planes(mat, sp_) == planes) & (_tension_planes(mat, sm_) == planes)
     return T, np.abs(T - fd).max(axis=(1, 2)), same, region
 
 
