@@ -89,14 +89,15 @@ from .errors import ProblemError
 from .explicit_settings import Explicit
 from .linear_static import Timer, discretise
 from .lumped_mass import lumped_mass
-from .mohr_coulomb import ELASTIC, MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
+from .mohr_coulomb import (ELASTIC, MohrCoulomb, elastic_strain, equivalent_plastic_strain,
+                           plastic_strain_increment)
 from .objective_stress import det_c, first_piola_c, hughes_winget_c, largest_strain_c, relative_c, rotate_c
 from .output import SeriesWriter
 from .problem_file import Case
 from .result import Result
 from .rpim import shape_functions
 from .state_transfer import NodalProjection
-from .walls import Wall, enforce_walls, kinetic_energy
+from .walls import Wall, enforce_walls
 
 #: Largest |grad N| d_c of a point that integrates: regular clouds give 1.2 to 1.7, a thinned flow front
 #: up to about 7; 40 to 60 was measured at points left beyond the nodes of a front (spurious stiffness
@@ -137,6 +138,10 @@ class Frame:
     def __post_init__(self) -> None:
         self.ST = self.S.T.tocsr()
         self.m = len(self.w)
+
+    def moved_points(self, x: np.ndarray) -> np.ndarray:
+        """(m, 2) where the points are when the nodes have moved from the frame's positions to ``x``."""
+        return self.points + np.asarray(self.N @ (x - self.x))
 
     def gradient(self, d: np.ndarray) -> np.ndarray:
         """(m, 4) F = I + grad d (xx, xy, yx, yy) of nodal displacements d (n, 2) relative to x."""
@@ -366,9 +371,9 @@ class ExplicitRun:
         if inverted.any():
             # a point the step turns inside out: a few at a ragged front are dropped like the points
             # without shape functions (weight 0, no stress, counted); many at once is an unstable step
-            i = int(np.flatnonzero(inverted)[np.argmin(np.where(np.isfinite(J[inverted]), J[inverted], -np.inf))])
             if inverted.sum() > INVERTED_LIMIT * np.count_nonzero(fr.w):
-                p = fr.points[i] + np.asarray(fr.N[i] @ (x - fr.x)).ravel()
+                i = int(np.argmin(np.where(inverted, np.where(np.isfinite(J), J, -np.inf), np.inf)))
+                p = fr.moved_points(x)[i]
                 raise Diverged(f"the step inverts the material at {int(inverted.sum())} integration points (det f = "
                                f"{J[i]:.3g} at #{i} near ({p[0]:.5g}, {p[1]:.5g})) at step {self.step}, t = "
                                f"{self.t:.6g} s; use a smaller explicit.dt or explicit.cfl")
@@ -416,25 +421,24 @@ class ExplicitRun:
         w_now = old.w * det_c(F)
         self.laid = _compose(F, self.laid)
         relay = largest_strain_c(self.laid) > s.relay_strain
-        points = old.points + np.asarray(old.N @ (self.x - old.x))
-        try:
-            if relay:
-                try:
-                    new = self.lay_frame(self.x, old.free)
-                except Diverged:
-                    raise
-                except ProblemError as exc:
-                    # the alpha shape cannot be traced on this cloud (a pinch it cannot split): go on with
-                    # the carried points and try again at the next rebuild (counted, the first reason kept)
-                    self.relay_failures += 1
-                    self.relay_failure = self.relay_failure or f"step {self.step}, t = {self.t:.6g} s: {exc.message}"
-                    relay = False
-            if not relay:
-                new = self.frame_at(self.x, old.free, points, w_now, old.boundary.loops)
-        except Diverged as exc:
-            raise Diverged(f"{exc.message} (rebuild at step {self.step}, t = {self.t:.6g} s)") from None
-        except ProblemError as exc:
-            raise Diverged(f"the rebuild at step {self.step}, t = {self.t:.6g} s failed: {exc.message}") from None
+        when = f"step {self.step}, t = {self.t:.6g} s"
+        new = None
+        if relay:
+            try:
+                new = self.lay_frame(self.x, old.free)
+            except Diverged as exc:
+                raise Diverged(f"{exc.message} (rebuild at {when})") from None
+            except ProblemError as exc:
+                # the alpha shape cannot be traced on this cloud (a pinch it cannot split): go on with
+                # the carried points and try again at the next rebuild (counted, the first reason kept)
+                self.relay_failures += 1
+                self.relay_failure = self.relay_failure or f"{when}: {exc.message}"
+                relay = False
+        if new is None:
+            try:
+                new = self.frame_at(self.x, old.free, old.moved_points(self.x), w_now, old.boundary.loops)
+            except ProblemError as exc:
+                raise Diverged(f"the rebuild at {when} failed: {exc.message}") from None
         self.timer.lap("rebuild")
         if relay:
             area, carried = new.boundary.area, float(w_now.sum()) / self.thickness
@@ -466,16 +470,15 @@ class ExplicitRun:
 
     # -- energy, output ------------------------------------------------------------------------------
     def _elastic_density(self, stress: np.ndarray) -> np.ndarray:
-        E, nu = self.material.E, self.material.nu
-        sxx, syy, sxy, szz = stress.T
-        trace = sxx + syy + szz
-        return ((1 + nu) * (sxx ** 2 + syy ** 2 + szz ** 2 + 2 * sxy ** 2) - nu * trace ** 2) / (2 * E)
+        """sigma : C sigma / 2 at the points."""
+        return 0.5 * _contract(stress, elastic_strain(self.material, stress))
 
     def elastic_energy(self) -> float:
         return float((self.frame.w * det_c(self.F)) @ self._elastic_density(self.stress))
 
     def kinetic_energy(self) -> float:
-        return kinetic_energy(self.mass, self.v)
+        """0.5 sum m |v|^2 at the half step."""
+        return 0.5 * float(self.mass @ np.einsum("nd,nd->n", self.v, self.v))
 
     def nodal_fields(self) -> dict[str, np.ndarray]:
         """Stress and equivalent plastic strain projected onto the nodes, with u and velocity."""
@@ -511,13 +514,12 @@ class ExplicitRun:
         try:
             if self.stage == "gravity":
                 bar.set_description("gravity stage")
-                gates = list(self.walls)
                 while self.stage_residual > s.stage_tolerance:
                     if self.stage_steps >= s.stage_steps:
                         raise Diverged(f"the gravity stage did not come to rest in {s.stage_steps} steps "
                                        f"(out-of-balance force {self.stage_residual:.2e} of the weight); raise "
                                        "explicit.stage_steps or explicit.stage_tolerance", key="explicit.stage_steps")
-                    self.advance(gates, s.stage_damping)
+                    self.advance(self.walls, s.stage_damping)       # the gates stand
                     self.stage_steps += 1
                     self.rebuild_if_needed()
                     self._maybe_checkpoint()

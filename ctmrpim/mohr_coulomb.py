@@ -193,14 +193,18 @@ class MohrCoulomb:
                 "t1": (e[0], e[0], self.tension), "t2": (e[1], e[1], self.tension), "t3": (e[2], e[2], self.tension)}
 
 
+def elastic_strain(material: "MohrCoulomb", stress: np.ndarray) -> np.ndarray:
+    """(m, 4) C sigma (xx, yy, xy tensor, zz) with the isotropic compliance, of stresses (m, 4)."""
+    E, nu = material.E, material.nu
+    trace = stress[:, 0] + stress[:, 1] + stress[:, 3]
+    return ((1.0 + nu) * stress - nu * trace[:, None] * np.array([1.0, 1.0, 0.0, 1.0])) / E
+
+
 def plastic_strain_increment(material: "MohrCoulomb", dstrain: np.ndarray, dstress: np.ndarray) -> np.ndarray:
     """(m, 4) plastic strain increment (xx, yy, xy tensor, zz): the total increment (ezz = 0 in plane
-    strain) less the elastic one, C dsigma with the isotropic compliance."""
-    E, nu = material.E, material.nu
-    trace = dstress[:, 0] + dstress[:, 1] + dstress[:, 3]
-    elastic = ((1.0 + nu) * dstress - nu * trace[:, None] * np.array([1.0, 1.0, 0.0, 1.0])) / E
+    strain) less the elastic one, C dsigma."""
     total = np.c_[dstrain[:, 0], dstrain[:, 1], 0.5 * dstrain[:, 2], np.zeros(len(dstrain))]
-    return total - elastic
+    return total - elastic_strain(material, dstress)
 
 
 def equivalent_plastic_strain(plastic_strain: np.ndarray) -> np.ndarray:

@@ -11,8 +11,8 @@ rule:
   change (the impulse ratio of Coulomb friction), and to zero when that is enough (stick);
 - ``friction = 0``: a frictionless roller (the paper's left wall, and the gate).
 
-A node may leave a wall whenever its forces pull it away (no adhesion). The kinetic energy removed by
-the contact is returned so the energy bookkeeping can count it.
+A node may leave a wall whenever its forces pull it away (no adhesion). The energy the walls take out
+is the work of their velocity corrections, booked by the explicit solver.
 
 A ``gate`` wall holds the column during the initial gravity stage only and is removed at t = 0.
 """
@@ -77,8 +77,3 @@ def enforce_walls(walls: list[Wall], x: np.ndarray, v: np.ndarray, dt: float) ->
         dvn = vn_new - vn[hit]                       # > 0: the normal impulse per unit mass
         v[hit] = wall.slip(v[hit] - vn[hit, None] * n, dvn) + vn_new[:, None] * n
     return v
-
-
-def kinetic_energy(mass: np.ndarray, v: np.ndarray) -> float:
-    """0.5 sum m |v|^2 for nodal masses (n,) and velocities (n, 2)."""
-    return 0.5 * float(mass @ np.einsum("nd,nd->n", v, v))

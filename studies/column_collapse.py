@@ -50,16 +50,22 @@ def specs(quick: bool) -> list[CaseSpec]:
                      labels=(("grid", f"{nx} x {ny}"),)) for nx, ny in grids]
 
 
-def final_state(folder: Path) -> tuple[float, meshio.Mesh]:
-    """The last saved state of an explicit run's series (time, mesh)."""
-    t, f = read_pvd(Path(folder) / "result.pvd")[-1]
+def state_at(folder: Path, time: float | None = None) -> tuple[float, meshio.Mesh]:
+    """The saved state of an explicit run's series nearest ``time`` (the last one if None): (time, mesh)."""
+    states = read_pvd(Path(folder) / "result.pvd")
+    t, f = states[-1] if time is None else min(states, key=lambda s: abs(s[0] - time))
     return t, meshio.read(f)
+
+
+def boundary_edges(mesh: meshio.Mesh) -> np.ndarray:
+    """(e, 2) the tracked boundary saved with a state (its line cells)."""
+    return np.concatenate([c.data for c in mesh.cells if c.type == "line"])
 
 
 def measures(mesh: meshio.Mesh, d_c: float) -> dict:
     """The deposit of one state against the experiment."""
     x = mesh.points[:, :2]
-    edges = np.concatenate([c.data for c in mesh.cells if c.type == "line"])
+    edges = boundary_edges(mesh)
     u = mesh.point_data["u"][:, :2]
     surface, line = benchmarks.data(DATA, "final_surface"), benchmarks.data(DATA, "failure_line")
     xs = np.arange(0.0, max(x[:, 0].max(), surface[:, 0].max()) + d_c, 0.25 * d_c)
@@ -87,12 +93,11 @@ def measures(mesh: meshio.Mesh, d_c: float) -> dict:
 def extra(summary: dict, folder: Path) -> dict:
     dyn = summary["dynamics"]
     e = dyn["energy"]
-    t, mesh = final_state(folder)
+    t, mesh = state_at(folder)
     d_c = summary["parameters"]["derived"]["d_c"]
     stopped = {}
     if t >= FINAL:      # the deposit when the front has stopped, before the late creep of the surface
-        te, f = min(read_pvd(Path(folder) / "result.pvd"), key=lambda s: abs(s[0] - FRONT_STOPPED))
-        m = measures(meshio.read(f), d_c)
+        m = measures(state_at(folder, FRONT_STOPPED)[1], d_c)
         stopped = {f"{k}_at_{FRONT_STOPPED:g}s": m[k] for k in ("run_out_m", "height_at_wall_m", "surface_max_dev_m",
                                                                   "surface_mean_dev_m", "failure_line_mean_dist_m",
                                                                   "slope_deg")}
@@ -125,7 +130,7 @@ def figure(df: pd.DataFrame):
     if len(ok):
         main = ok.iloc[min(1, len(ok) - 1)]          # the paper's 1071 nodes in full mode
         states = read_pvd(Path(main.folder) / "result.pvd")
-        final_t, final = final_state(Path(main.folder))
+        final_t, final = state_at(Path(main.folder))
         vmax = float(np.nanmax(final.point_data["displacement"]))
         shown = [min(states, key=lambda s: abs(s[0] - t)) for t in SNAPSHOTS if t <= final_t] + [states[-1]]
         for k, (t, f) in enumerate(shown[:4]):

@@ -14,8 +14,10 @@ from __future__ import annotations
 import json
 import sys
 
+import numpy as np
 import pandas as pd
 
+from ctmrpim.deposit import surface_profile
 from ctmrpim.sweep import CaseSpec
 
 from . import column_collapse
@@ -25,6 +27,8 @@ TITLE = "Column collapse: deposit against the rebuild criterion and the time ste
 GRID = "nodes.grid=[31, 16]"
 #: the fixed-step run (40 times the steps) is compared with the others at this time (s), the flow's middle
 EARLY = 0.3
+#: abscissae of the surfaces compared at EARLY (m): one grid for every cloud
+EARLY_XS = np.arange(0.0, 0.5, 0.002)
 VARIANTS = {"full": [("default", ()), ("rebuild_strain 0.1", ("explicit.rebuild_strain=0.1",)),
                      ("rebuild_strain 0.4", ("explicit.rebuild_strain=0.4",)),
                      ("relay_strain 0.5", ("explicit.relay_strain=0.5",)),
@@ -39,28 +43,16 @@ def specs(quick: bool) -> list[CaseSpec]:
 
 
 def extra(summary: dict, folder) -> dict:
-    from pathlib import Path
-
-    import meshio
-    import numpy as np
-    from ctmrpim.deposit import surface_profile
-    from ctmrpim.output import read_pvd
-
-    row = column_collapse.extra(summary, folder)
-    t, f = min(read_pvd(Path(folder) / "result.pvd"), key=lambda e: abs(e[0] - EARLY))
-    m = meshio.read(f)
-    edges = np.concatenate([c.data for c in m.cells if c.type == "line"])
-    xs = np.arange(0.0, 0.5, 0.002)
-    h = surface_profile(m.points[:, :2], edges, xs)
-    front = column_collapse.run_out(xs, h, column_collapse.RUN_OUT_THICKNESS)
-    return {**row, "early_time_s": t, "early_front_m": front, "early_profile": json.dumps(h.round(6).tolist())}
+    t, mesh = column_collapse.state_at(folder, EARLY)
+    h = surface_profile(mesh.points[:, :2], column_collapse.boundary_edges(mesh), EARLY_XS)
+    front = column_collapse.run_out(EARLY_XS, h, column_collapse.RUN_OUT_THICKNESS)
+    return {**column_collapse.extra(summary, folder), "early_time_s": t, "early_front_m": front,
+            "early_profile": json.dumps(h.round(6).tolist())}
 
 
 def early_differences(df: pd.DataFrame) -> pd.DataFrame:
     """Largest and mean vertical distance (m) of each run's surface at EARLY from the fixed-step (paper)
     run's, over the abscissae where either surface is above the base."""
-    import numpy as np
-
     ok = df[df.status == "ok"]
     ref = ok[ok.variant.str.startswith("dt ")]
     out = pd.DataFrame(np.nan, index=df.index, columns=["surface_vs_fixed_step_max_m", "surface_vs_fixed_step_mean_m"])
@@ -77,13 +69,12 @@ def early_differences(df: pd.DataFrame) -> pd.DataFrame:
 
 def figure(df: pd.DataFrame):
     import matplotlib.pyplot as plt
-    import numpy as np
 
     fig, axes = plt.subplots(1, 2, figsize=(14, 4), gridspec_kw={"width_ratios": [2.5, 1]})
     ok = df[df.status == "ok"]
     ax = axes[0]
     for _, r in ok.iterrows():
-        ax.plot(np.arange(0.0, 0.5, 0.002), json.loads(r.early_profile), lw=1.2,
+        ax.plot(EARLY_XS, json.loads(r.early_profile), lw=1.2,
                 label=f"{r.variant}: front {r.early_front_m:.3f} m at t = {r.early_time_s:.2f} s")
     ax.set(xlabel="x (m)", ylabel="surface height (m)", xlim=(0, 0.5), ylim=(0, 0.11),
            title=f"surface at t = {EARLY} s (496 nodes)")
