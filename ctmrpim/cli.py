@@ -240,8 +240,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="explicit dynamics: continue from the checkpoint in the output folder")
     p.set_defaults(func=cmd_run)
     p = sub.add_parser("study", help="run a parameter study (tables and figures under reports/)")
-    p.add_argument("name", help="study name, or all: node-density, integration-density, support-radius, "
-                                "shape-parameter, parameter-map, time-to-accuracy, plate-hole-convergence")
+    from studies import ALIASES
+    p.add_argument("name", help="study name, or all: " + ", ".join(ALIASES))
     p.add_argument("--quick", action="store_true", help="the small version CI runs")
     _sweep_options(p)
     p.set_defaults(func=cmd_study)

@@ -16,10 +16,11 @@ class Explicit:
     dt: float | str = "cfl"        # time step (s), or "cfl": cfl x 2 / omega_max, recomputed at each rebuild
     cfl: float = 0.5
     damping: float = 0.0           # local damping factor f of Eq. (11); 0: true dynamics
+    viscosity: float = 0.0         # beta (s): stiffness-proportional damping, a viscous stress beta D d(eps)/dt
     rebuild_strain: float = 0.2    # RPIM rebuilt once a point is strained this much since the last rebuild
     relay_strain: float = 1.0      # boundary re-tracked, CTM points laid anew (state transferred) once a point
                                    # is strained this much since the points were laid
-    area_jump: float = 0.02        # the run stops when a re-tracked area differs from the body's by more
+    area_jump: float = 0.02        # the run stops when a re-tracked area jumps by more than this fraction
     save_every: float = 0.01       # simulated seconds between saved states (VTU series)
     checkpoint_every: int = 1000   # steps between checkpoints (0: none)
     rest: float = 1e-4             # at rest once the kinetic energy is below rest x its peak
@@ -35,6 +36,7 @@ class Explicit:
                                               and self.dt > 0), "must be \"cfl\" or a time step > 0 (s)"),
                   ("cfl", 0 < self.cfl <= 1, "must lie in (0, 1]"),
                   ("damping", 0 <= self.damping < 1, "must lie in [0, 1)"),
+                  ("viscosity", self.viscosity >= 0, "must be >= 0 (s)"),
                   ("rebuild_strain", self.rebuild_strain > 0, "must be > 0"),
                   ("relay_strain", self.relay_strain >= self.rebuild_strain, "must be >= rebuild_strain"),
                   ("area_jump", 0 < self.area_jump < 1, "must lie in (0, 1)"),

@@ -198,10 +198,12 @@ def relative_c(F_new: np.ndarray, F: np.ndarray) -> np.ndarray:
     return np.stack([a00 * i00 + a01 * i10, a00 * i01 + a01 * i11, a10 * i00 + a11 * i10, a10 * i01 + a11 * i11], axis=1)
 
 
-def hughes_winget_c(f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The strain increment (m, 3: exx, eyy, engineering gxy) and the rotation Q = [[c, -s], [s, c]]
-    (c, s) of :func:`hughes_winget`: G = L (I + L/2)^-1, Q = (I - W/2)^-1 (I + W/2) with W = skew G."""
-    L00, L01, L10, L11 = f[:, 0] - 1.0, f[:, 1], f[:, 2], f[:, 3] - 1.0
+def hughes_winget_components(f00, f01, f10, f11):
+    """The strain increment (exx, eyy, engineering gxy) and the rotation Q = [[c, -s], [s, c]] (c, s) of
+    :func:`hughes_winget` from the components of f: G = L (I + L/2)^-1, Q = (I - W/2)^-1 (I + W/2) with
+    W = skew G. Arithmetic only, so it serves arrays (:func:`hughes_winget_c`) and, compiled, one point
+    at a time (:mod:`ctmrpim.explicit_point_update`)."""
+    L00, L01, L10, L11 = f00 - 1.0, f01, f10, f11 - 1.0
     A00, A01, A10, A11 = 1.0 + 0.5 * L00, 0.5 * L01, 0.5 * L10, 1.0 + 0.5 * L11
     det = A00 * A11 - A01 * A10
     G00 = (L00 * A11 - L01 * A10) / det
@@ -210,15 +212,25 @@ def hughes_winget_c(f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     G11 = (L11 * A00 - L10 * A01) / det
     h = 0.25 * (G01 - G10)                 # W/2 = [[0, h], [-h, 0]]
     scale = 1.0 / (1.0 + h * h)
-    return np.stack([G00, G11, G01 + G10], axis=1), (1.0 - h * h) * scale, -2.0 * h * scale
+    return G00, G11, G01 + G10, (1.0 - h * h) * scale, -2.0 * h * scale
+
+
+def hughes_winget_c(f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`hughes_winget_components` of gradients f (m, 4): the strain increments (m, 3) and (c, s)."""
+    e0, e1, e2, c, s = hughes_winget_components(f[:, 0], f[:, 1], f[:, 2], f[:, 3])
+    return np.stack([e0, e1, e2], axis=1), c, s
+
+
+def rotate_components(xx, yy, xy, c, s):
+    """The in-plane components of Q t Q^T for Q = [[c, -s], [s, c]] (arrays or, compiled, scalars)."""
+    cc, ss, cs = c * c, s * s, c * s
+    return cc * xx - 2.0 * cs * xy + ss * yy, ss * xx + 2.0 * cs * xy + cc * yy, cs * (xx - yy) + (cc - ss) * xy
 
 
 def rotate_c(state: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
     """Q t Q^T of tensors (m, 4: xx, yy, xy, zz) for Q = [[c, -s], [s, c]]; zz unchanged."""
-    xx, yy, xy = state[:, 0], state[:, 1], state[:, 2]
-    cc, ss, cs = c * c, s * s, c * s
-    return np.stack([cc * xx - 2.0 * cs * xy + ss * yy, ss * xx + 2.0 * cs * xy + cc * yy,
-                     cs * (xx - yy) + (cc - ss) * xy, state[:, 3]], axis=1)
+    xx, yy, xy = rotate_components(state[:, 0], state[:, 1], state[:, 2], c, s)
+    return np.stack([xx, yy, xy, state[:, 3]], axis=1)
 
 
 def largest_strain_c(F: np.ndarray) -> float:

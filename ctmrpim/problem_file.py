@@ -257,8 +257,9 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     if analysis == "explicit":
         if "dt" in (ex_raw or {}) and ex_raw["dt"] != "cfl":
             ex_raw = {**ex_raw, "dt": num(ex_raw["dt"], "explicit.dt")}
-        explicit = settings(Explicit, "explicit", ex_raw, ("duration", "cfl", "damping", "rebuild_strain", "relay_strain", "area_jump",
-                                                           "save_every", "rest", "stage_damping", "stage_tolerance"))
+        explicit = settings(Explicit, "explicit", ex_raw, ("duration", "cfl", "damping", "viscosity", "rebuild_strain",
+                                                           "relay_strain", "area_jump", "save_every", "rest",
+                                                           "stage_damping", "stage_tolerance"))
     if raw.get("wall") and analysis != "explicit":
         raise ProblemError("[[wall]] (rigid contact) needs analysis = \"explicit\"", key="wall")
     if loading.tangent == "elastic" and mat["model"] != "mohr-coulomb":

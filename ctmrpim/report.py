@@ -271,10 +271,12 @@ COLLAPSE_COLUMNS = ["grid", "nodes", "end_time_s", "at_rest", "run_out_m", "heig
 
 def collapse_checks(df: pd.DataFrame) -> pd.DataFrame:
     """The column collapse against the experiment, for every run that reached the end of the flow
-    (quick mode: none)."""
+    (at rest, or FINAL; quick mode: none)."""
     from studies.column_collapse import FINAL
     rows = []
-    for _, r in df[(df.status == "ok") & (df.get("end_time_s", 0.0) >= FINAL)].iterrows():
+    if "end_time_s" not in df:
+        return pd.DataFrame(rows)
+    for _, r in df[(df.status == "ok") & (df.at_rest.astype(bool) | (df.end_time_s >= FINAL))].iterrows():
         variant = f"{r.nodes} nodes"
         rows.append(_row("column-collapse-run-out", abs(r.run_out_m / r.run_out_measured_m - 1.0), variant))
         rows.append(_row("column-collapse-height", abs(r.height_at_wall_m / 0.100 - 1.0), variant))
@@ -302,6 +304,12 @@ def _collapse_section(w, tables: dict[str, pd.DataFrame], quick: bool) -> None:
                           "surface_vs_fixed_step_mean_m", "steps", "rebuilds", "dt_min_s", "ms_per_step", "time_s",
                           "status"] if c in st]]))
     w("\n\n![column collapse settings](column_collapse_settings.png)\n\n")
+    w(f"### Viscosity\n\n{studies.study('column_collapse_viscosity').__doc__.strip()}\n\n")
+    vs = tables["column_collapse_viscosity"]
+    w(_md(vs[[c for c in ["viscosity_s", "nodes", "end_time_s", "at_rest", "run_out_m", "height_at_wall_m",
+                          "surface_max_dev_m", "surface_mean_dev_m", "failure_line_mean_dist_m", "slope_deg",
+                          "viscous_share", "steps", "time_s", "status"] if c in vs]]))
+    w("\n\n![column collapse viscosity](column_collapse_viscosity.png)\n\n")
     w(COLLAPSE_NOTES)
 
 

@@ -8,13 +8,15 @@ from __future__ import annotations
 from importlib import import_module
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
-import pandas as pd
+if TYPE_CHECKING:
+    import pandas as pd
 
 NAMES = ["node_density", "integration_density", "support_radius", "shape_parameter", "parameter_map",
          "time_to_accuracy", "plate_hole_convergence", "tip_load", "end_moment", "slope_stability",
          "slope_srf_sweep", "slope_relaxation", "footing_bearing", "slope_slide", "column_collapse",
-         "column_collapse_settings"]
+         "column_collapse_settings", "column_collapse_viscosity"]
 #: command-line spelling (dashes) -> module name
 ALIASES = {n.replace("_", "-"): n for n in NAMES}
 
