@@ -4,7 +4,8 @@ Central differences are stable for dt <= 2 / omega_max, omega_max^2 the largest 
 M^-1 K (lumped mass, elastic stiffness). omega_max is estimated by power iteration with the elastic
 internal-force operator of the current configuration (one gradient and one transposed product per
 iteration, no matrix assembled), warm-started from the last estimate's vector at each rebuild; the
-step is dt = cfl x 2 / omega_max (cfl = 0.5 covers the estimate's shortfall, plasticity and contact).
+step is dt = cfl x 2 / omega_max (cfl = 0.5 covers the estimate's shortfall, plasticity and contact),
+shortened by the stiffness-proportional damping where there is one (:func:`stable_step`).
 The textbook bound 0.4 d_min / c_p (c_p the P-wave speed) is reported beside it.
 """
 from __future__ import annotations
@@ -38,6 +39,13 @@ def omega_max(stiffness: Callable[[np.ndarray], np.ndarray], mass: np.ndarray, s
             break
         z = y / norm
     return float(np.sqrt(max(lam, 0.0))), z / root
+
+
+def stable_step(omega: float, cfl: float, beta: float = 0.0) -> float:
+    """cfl x the stable step of central differences for the highest mode omega with stiffness-proportional
+    damping beta (s), whose damping ratio there is z = beta omega / 2: 2 / omega (sqrt(1 + z^2) - z)."""
+    zeta = 0.5 * beta * omega
+    return cfl * 2.0 / omega * (float(np.sqrt(1.0 + zeta * zeta)) - zeta)
 
 
 def checkerboard(points: np.ndarray, d_c: float) -> np.ndarray:

@@ -102,10 +102,11 @@ from scipy.spatial import cKDTree
 from .alpha_shape import Boundary, alpha_shape
 from .boundary_conditions import constrained_dofs
 from .checkpoint import NAME as CHECKPOINT, load_checkpoint, save_checkpoint
-from .critical_time_step import ITERATIONS, WARM_ITERATIONS, checkerboard, omega_max, wave_speed_step
+from .critical_time_step import (ITERATIONS, WARM_ITERATIONS, checkerboard, omega_max, stable_step,
+                                 wave_speed_step)
 from .ctm import integration_points
 from .errors import ProblemError
-from .explicit_point_update import point_update
+from .explicit_point_update import PointUpdate, point_update
 from .explicit_settings import Explicit
 from .gradient_operator import GradientOperator
 from .linear_static import Timer, discretise
@@ -154,9 +155,6 @@ class Frame:
         out = np.ones(len(self.x), bool)
         out[self.active] = False
         return out
-
-    def __post_init__(self) -> None:
-        self.m = len(self.w)
 
     def moved_points(self, x: np.ndarray) -> np.ndarray:
         """(m, 2) where the points are when the nodes have moved from the frame's positions to ``x``."""
@@ -289,9 +287,7 @@ class ExplicitRun:
         omega, self.mode = omega_max(self._stiffness(self.frame), self.mass, self.mode, self.movable,
                                      ITERATIONS if first else WARM_ITERATIONS)
         self.omega = omega
-        # the stable step of central differences with stiffness-proportional damping (ratio zeta at omega)
-        zeta = 0.5 * s.viscosity * omega
-        self.dt = float(s.dt) if s.dt != "cfl" else s.cfl * 2.0 / omega * (np.sqrt(1.0 + zeta * zeta) - zeta)
+        self.dt = float(s.dt) if s.dt != "cfl" else stable_step(omega, s.cfl, s.viscosity)
         self.dt_range = [min(self.dt_range[0], self.dt), max(self.dt_range[1], self.dt)]
 
     # -- the state -------------------------------------------------------------------------------------
@@ -408,28 +404,28 @@ class ExplicitRun:
         if self.material.tension is None:
             upd = point_update(self.material, f_inc, self.stress, self.plastic, dead, w, self.viscous,
                                self.settings.viscosity / dt)
-            stress, plastic, dissipation, self.viscous = upd.stress, upd.plastic, upd.dissipation, upd.viscous
-            if self.stage == "dynamic":
-                self.energy.viscous += upd.viscous_work
         else:
-            stress, plastic, dissipation = self._point_update_numpy(f_inc, dead, w)
+            upd = self._point_update_numpy(f_inc, dead, w)
         if self.stage == "dynamic":
-            self.energy.plastic += dissipation
+            self.energy.plastic += upd.dissipation
+            self.energy.viscous += upd.viscous_work
         self.timer.lap("material")
         self.x, self.v, self.F = x, v, F_new
-        self.stress, self.plastic = stress, plastic
+        self.stress, self.plastic, self.viscous = upd.stress, upd.plastic, upd.viscous
         self.t += dt
         self.step += 1
 
-    def _point_update_numpy(self, f_inc: np.ndarray, dead: np.ndarray, w: np.ndarray):
-        """:func:`ctmrpim.explicit_point_update.point_update` in numpy forms (the tension cut-off too)."""
+    def _point_update_numpy(self, f_inc: np.ndarray, dead: np.ndarray, w: np.ndarray) -> PointUpdate:
+        """:func:`ctmrpim.explicit_point_update.point_update` in numpy forms, for the tension cut-off
+        (no viscosity: refused with a tension cut-off)."""
         strain, c, s = hughes_winget_c(f_inc)
         rotated = rotate_c(self.stress, c, s)
         plastic = rotate_c(self.plastic, c, s)
-        stress, _ = self.material.update(rotated, strain)
+        stress, region = self.material.update(rotated, strain)
         dp = plastic_strain_increment(self.material, strain, stress - rotated)
         stress[dead], plastic[dead], dp[dead] = 0.0, 0.0, 0.0
-        return stress, plastic + dp, float(w @ _contract(0.5 * (rotated + stress), dp))
+        return PointUpdate(stress, plastic + dp, region, float(w @ _contract(0.5 * (rotated + stress), dp)),
+                           np.zeros_like(stress), 0.0)
 
     def _out_of_balance(self, f: np.ndarray, walls: list[Wall]) -> float:
         """|F_ext - F_int| over the weight, without what supports and walls in contact take."""
