@@ -1,4 +1,9 @@
-"""Command line: ``ctmrpim list | run TARGET | report``.
+"""Command line: ``ctmrpim list | run TARGET``, and the commands of installed applications.
+
+A thin layer over the public API (:func:`ctmrpim.load_case`, :func:`ctmrpim.solve`, the outputs of
+:mod:`ctmrpim.io`). Further commands come from entry points of the group ``ctmrpim.commands``: each
+is a function that adds its subcommands to the parser (the verification suite in ``studies/`` adds
+``study`` and ``report``), so this package never imports the application built on it.
 
 User mistakes (a bad problem file, an unknown benchmark, a selector that matches nothing) end with
 one line on stderr naming the file, key and reason, exit status 2, no traceback, and nothing written.
@@ -6,29 +11,20 @@ one line on stderr naming the file, key and reason, exit status 2, no traceback,
 from __future__ import annotations
 
 import argparse
-import difflib
-import os
-import shutil
 import sys
 import warnings
+from importlib.metadata import entry_points
 from pathlib import Path
 
-from . import benchmarks
-from .errors import ProblemError
-from .problem_file import Case, load_case
-from .result import Result
-from .solvers import ELEMENTS, METHODS, solve
+from ctmrpim import benchmarks, methods
+from ctmrpim.cases import load_case
+from ctmrpim.errors import ProblemError
+from ctmrpim.io.run_folder import write_outputs
+from ctmrpim.problem.case import Case
+from ctmrpim.result import Result
 
-def load_target(target: str, overrides: list[str]) -> Case:
-    """A benchmark name or a path to a problem file."""
-    if target in benchmarks.names():
-        return benchmarks.load(target, overrides)
-    p = Path(target)
-    if p.suffix == ".toml" or p.exists():
-        return load_case(p, overrides)
-    close = difflib.get_close_matches(target, benchmarks.names(), n=1)
-    hint = f" (did you mean {close[0]!r}?)" if close else ""
-    raise ProblemError(f"{target!r} is neither a benchmark ({', '.join(benchmarks.names())}) nor a problem file{hint}")
+#: entry-point group of commands that applications add to ``ctmrpim``
+COMMANDS = "ctmrpim.commands"
 
 
 def describe(result: Result, case: Case) -> str:
@@ -134,8 +130,9 @@ def _description(name: str) -> str:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    case = load_target(args.target, args.set or [])
-    suffix = "" if args.solver == "ctm-rpim" else f"-fem-{args.element}"
+    case = load_case(args.target, args.set or [])
+    element = methods.element_of(methods.get(args.solver), args.element)
+    suffix = "" if args.solver == methods.DEFAULT else f"-{args.solver}" + (f"-{element}" if element else "")
     out = Path(args.out) if args.out else Path("runs") / f"{case.problem.name}{suffix}"
     if args.resume and case.problem.analysis != "explicit":
         raise ProblemError("--resume continues an explicit dynamic run from its checkpoint; this analysis is "
@@ -143,8 +140,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     try:
         progress = None if args.quiet else (lambda level: print("  " + _level_line(level.record()), file=sys.stderr,
                                                                     flush=True))
-        result = solve(case, args.solver, args.element, progress=progress, out=out, resume=args.resume,
-                       progress_bar=not args.quiet)
+        result = methods.solve(case, args.solver, args.element, progress=progress, out=out, resume=args.resume,
+                               progress_bar=not args.quiet)
     except ProblemError as exc:  # raised while solving, e.g. a selector that matches no node: name the file
         raise exc.at(source=case.source) from None
     paths = write_outputs(result, case, out)
@@ -154,73 +151,6 @@ def cmd_run(args: argparse.Namespace) -> int:
         steps = len(paths) - len(shown)
         print("  wrote " + ", ".join(str(p) for p in shown) + (f" ({steps} increments in series/)" if steps else ""))
     return 0
-
-
-def write_outputs(result: Result, case: Case, out: Path) -> list[Path]:
-    """result.vtu, the increment series (result.pvd + series/*.vtu) where there is one, and
-    summary.json last; all or none (a folder this call created is removed again if a write fails, so
-    a failed run never leaves a half-written result behind)."""
-    from .output import write_series, write_summary, write_vtu
-
-    created = not out.exists()
-    paths: list[Path] = []
-    try:
-        paths.append(write_vtu(result, out))
-        for p in write_series(result, out):
-            paths.append(p)
-        paths.append(write_summary(result, out, case.source))
-    except BaseException as exc:
-        for p in paths:
-            p.unlink(missing_ok=True)
-        if created:
-            shutil.rmtree(out, ignore_errors=True)
-        if isinstance(exc, OSError):  # e.g. --out names an existing file, or a read-only folder
-            raise ProblemError(f"cannot write the results to {str(out)!r} ({exc.strerror or exc})",
-                               key="--out") from None
-        raise
-    return paths
-
-
-def _sweep(args: argparse.Namespace):
-    from studies.base import CACHE
-
-    from .sweep import Sweep
-    if args.workers < 1:
-        raise ProblemError(f"--workers {args.workers}: need at least 1")
-    return Sweep(CACHE, workers=args.workers, scheduler=args.scheduler, retry_failed=args.retry_failed)
-
-
-def cmd_study(args: argparse.Namespace) -> int:
-    import studies
-
-    names = studies.NAMES if args.name == "all" else [args.name]
-    for name in names:
-        if studies.ALIASES.get(name, name) not in studies.NAMES:
-            close = difflib.get_close_matches(name, list(studies.ALIASES), n=1)
-            raise ProblemError(f"unknown study {name!r}{f' (did you mean {close[0]!r}?)' if close else ''}; "
-                               f"available: {', '.join(studies.ALIASES)} or all")
-    sweep = _sweep(args)
-    for name in names:
-        df = studies.run(name, args.quick, Path(args.out), sweep)
-        shown = df.drop(columns=[c for c in df if c == "status" or df[c].astype(str).str.startswith(("{", "[")).any()
-                                 or c == "folder"])      # curves and profiles (JSON) stay in the CSV
-        print(shown.to_string(index=False))
-    return 0
-
-
-def cmd_report(args: argparse.Namespace) -> int:
-    from .report import make_report
-    path = make_report(quick=not args.full, out_dir=Path(args.out), sweep=_sweep(args))
-    print(f"wrote {path}")
-    return 0
-
-
-def _sweep_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", default="reports", help="folder for tables and figures (default reports/)")
-    p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
-                   help="local worker processes for the sweeps (default: one per core; 1 runs in this process)")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="run the sweeps on this Dask scheduler instead")
-    p.add_argument("--retry-failed", action="store_true", help="recompute cases that failed before")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -233,24 +163,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="output folder (default runs/NAME)")
     p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE",
                    help="override a problem-file value, e.g. --set nodes.grid=[65,17] (repeatable)")
-    p.add_argument("--solver", choices=METHODS, default="ctm-rpim")
-    p.add_argument("--element", choices=ELEMENTS, default="q1", help="FEM element (with --solver fem)")
+    p.add_argument("--solver", choices=methods.names(), default=methods.DEFAULT,
+                   help="the method (default ctm-rpim; fem: the scikit-fem reference)")
+    p.add_argument("--element", help="element of a finite-element method: q1, p1 or p2 for fem (default q1)")
     p.add_argument("--quiet", action="store_true", help="print nothing on success")
     p.add_argument("--resume", action="store_true",
                    help="explicit dynamics: continue from the checkpoint in the output folder")
     p.set_defaults(func=cmd_run)
-    p = sub.add_parser("study", help="run a parameter study (tables and figures under reports/)")
-    from studies import ALIASES
-    p.add_argument("name", help="study name, or all: " + ", ".join(ALIASES))
-    p.add_argument("--quick", action="store_true", help="the small version CI runs")
-    _sweep_options(p)
-    p.set_defaults(func=cmd_study)
-    p = sub.add_parser("report", help="regenerate the verification report")
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--quick", action="store_true", help="quick mode (default)")
-    g.add_argument("--full", action="store_true", help="every study at the paper's resolution")
-    _sweep_options(p)
-    p.set_defaults(func=cmd_report)
+    for ep in entry_points(group=COMMANDS):     # e.g. `study` and `report` of the verification suite
+        ep.load()(sub)
     return ap
 
 

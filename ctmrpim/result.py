@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from .problem import Problem
+from ctmrpim.problem.model import Problem
 
 STRESS_NAMES = ("sxx", "syy", "sxy")
 

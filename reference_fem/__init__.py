@@ -1,5 +1,9 @@
-"""scikit-fem reference solver (Q1, P1, P2) for the same problems the CTM-RPIM solver solves."""
-from .hyperelastic import solve_fem_hyperelastic
-from .solve import solve_fem
+"""scikit-fem reference solver (Q1, P1, P2) for the same problems the CTM-RPIM solver solves.
+
+It registers itself as the method ``"fem"`` of :mod:`ctmrpim.methods` (through the entry point
+``ctmrpim.methods``), so ``ctmrpim.solve(case, "fem", "p2")`` reaches it without the core importing it.
+"""
+from reference_fem.hyperelastic import solve_fem_hyperelastic
+from reference_fem.solve import solve_fem
 
 __all__ = ["solve_fem", "solve_fem_hyperelastic"]

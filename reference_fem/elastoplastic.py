@@ -20,11 +20,11 @@ from scipy.sparse import csc_matrix
 from scipy.sparse.linalg import splu
 from skfem import Basis, BilinearForm, ElementQuad1, ElementTriP1, ElementVector, FacetBasis, LinearForm
 
-from ctmrpim.elastoplastic import PlasticOutput, PlasticSystem, run_elastoplastic
+from ctmrpim.solvers.plastic_system import PlasticOutput, PlasticSystem, run_elastoplastic
 from ctmrpim.errors import ProblemError
-from ctmrpim.linear_static import Timer
-from ctmrpim.mohr_coulomb import MohrCoulomb
-from ctmrpim.problem_file import Case
+from ctmrpim.timing import Timer
+from ctmrpim.materials.mohr_coulomb import MohrCoulomb
+from ctmrpim.problem.case import Case
 from ctmrpim.result import Result, probe_record
 
 from .mesh import build_mesh

@@ -23,9 +23,9 @@ from scipy.sparse.linalg import splu
 from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, condense, solve
 
 from ctmrpim.errors import ProblemError
-from ctmrpim.hyperelastic import NeoHookean
-from ctmrpim.load_stepping import step_loads
-from ctmrpim.problem_file import Case
+from ctmrpim.materials.neo_hookean import NeoHookean
+from ctmrpim.solvers.load_stepping import step_loads
+from ctmrpim.problem.case import Case
 from ctmrpim.result import Result, probe_record
 
 from .mesh import FemMesh, build_mesh

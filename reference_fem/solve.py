@@ -17,11 +17,11 @@ from skfem import (Basis, BilinearForm, ElementQuad1, ElementTriP1, ElementTriP2
 from skfem.assembly.basis import AbstractBasis
 from skfem.mesh import Mesh
 
-from ctmrpim.error_norms import relative_errors
+from ctmrpim.reference.error_norms import relative_errors
 from ctmrpim.errors import ProblemError
-from ctmrpim.expressions import Field
-from ctmrpim.problem import Problem
-from ctmrpim.problem_file import Case
+from ctmrpim.problem.expressions import Field
+from ctmrpim.problem.model import Problem
+from ctmrpim.problem.case import Case
 from ctmrpim.result import Result, probe_errors, probe_record
 
 from .mesh import FemMesh, build_mesh

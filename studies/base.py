@@ -14,8 +14,8 @@ from typing import Any
 
 import pandas as pd
 
-from ctmrpim.output import atomic_write, atomic_write_text
-from ctmrpim.sweep import CaseOutcome, CaseSpec, Sweep
+from ctmrpim.io.atomic import atomic_write, atomic_write_text
+from studies.sweep import CaseOutcome, CaseSpec, Sweep
 
 CACHE = Path("runs") / "sweeps"   # one folder per case, named by the hash of its resolved input
 

@@ -5,7 +5,7 @@ import argparse
 from pathlib import Path
 from types import ModuleType
 
-from ctmrpim.sweep import Sweep
+from studies.sweep import Sweep
 
 from .base import CACHE, run_study
 

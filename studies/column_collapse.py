@@ -24,9 +24,9 @@ import numpy as np
 import pandas as pd
 
 from ctmrpim import benchmarks
-from ctmrpim.deposit import curve_distance, failure_line, run_out, slope_angle, surface_profile
-from ctmrpim.output import read_pvd
-from ctmrpim.sweep import CaseSpec
+from ctmrpim.reference.deposit import curve_distance, failure_line, run_out, slope_angle, surface_profile
+from ctmrpim.io.vtu import read_pvd
+from studies.sweep import CaseSpec
 
 NAME = "column_collapse"
 TITLE = "Granular column collapse: final deposit against Bui et al. (2008) (cf. Fig. 28)"

@@ -17,8 +17,8 @@ import sys
 import numpy as np
 import pandas as pd
 
-from ctmrpim.deposit import surface_profile
-from ctmrpim.sweep import CaseSpec
+from ctmrpim.reference.deposit import surface_profile
+from studies.sweep import CaseSpec
 
 from . import column_collapse
 

@@ -18,7 +18,7 @@ import sys
 import pandas as pd
 
 from ctmrpim import benchmarks
-from ctmrpim.sweep import CaseSpec
+from studies.sweep import CaseSpec
 
 from . import column_collapse
 

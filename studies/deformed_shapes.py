@@ -11,8 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ctmrpim import benchmarks, elastica
-from ctmrpim.solvers import solve
+from ctmrpim import benchmarks
+from ctmrpim.reference import elastica
+from ctmrpim.methods import solve
 
 from .base import finished, new_figure, save_figure
 

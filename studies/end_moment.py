@@ -15,8 +15,8 @@ import sys
 import numpy as np
 import pandas as pd
 
-from ctmrpim import elastica
-from ctmrpim.sweep import CaseSpec
+from ctmrpim.reference import elastica
+from studies.sweep import CaseSpec
 
 from .base import finished, new_figure
 

@@ -16,7 +16,7 @@ import sys
 import numpy as np
 import pandas as pd
 
-from ctmrpim.sweep import CaseSpec
+from studies.sweep import CaseSpec, element_of
 
 from .base import finished, new_figure
 
@@ -29,7 +29,7 @@ GRIDS = {"quick": [(49, 21)], "full": [(37, 16), (49, 21), (73, 31)]}
 def specs(quick: bool) -> list[CaseSpec]:
     grids = GRIDS["quick" if quick else "full"]
     return [CaseSpec("footing", (f"parameters.nx={nx}", f"parameters.ny={ny}"), solver,
-                     "p2", labels=(("grid", f"{nx} x {ny}"),))
+                     element_of(solver, "p2"), labels=(("grid", f"{nx} x {ny}"),))
             for nx, ny in grids for solver in ("ctm-rpim", "fem")]
 
 

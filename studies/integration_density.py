@@ -8,7 +8,7 @@ import sys
 
 import pandas as pd
 
-from ctmrpim.sweep import CaseSpec
+from studies.sweep import CaseSpec
 
 from .one_parameter import cantilever_specs, error_plot
 

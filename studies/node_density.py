@@ -11,7 +11,7 @@ import sys
 
 import pandas as pd
 
-from ctmrpim.sweep import CaseSpec
+from studies.sweep import CaseSpec
 
 from .base import finished, new_figure
 from .fitting import fitted_rate
@@ -21,7 +21,7 @@ TITLE = "Node density (cf. Fig. 9)"
 QUICK_GRIDS = [(17, 5), (33, 9), (65, 17)]
 FULL_GRIDS = QUICK_GRIDS + [(129, 33), (257, 65)]
 LENGTH = 48.0
-METHODS = [("ctm-rpim", "q1", ()), ("ctm-rpim", "q1", ('method.polynomial="quadratic"',)),
+METHODS = [("ctm-rpim", None, ()), ("ctm-rpim", None, ('method.polynomial="quadratic"',)),
            ("fem", "q1", ()), ("fem", "p1", ()), ("fem", "p2", ())]
 
 

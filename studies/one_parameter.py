@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ctmrpim.sweep import CaseSpec
+from studies.sweep import CaseSpec
 
 from .base import finished, new_figure
 

@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pandas as pd
 
-from ctmrpim.sweep import CaseSpec
+from studies.sweep import CaseSpec
 
 from .base import new_figure
 

@@ -9,8 +9,8 @@ import sys
 import pandas as pd
 
 from ctmrpim import benchmarks
-from ctmrpim.problem_file import Case
-from ctmrpim.sweep import CaseSpec
+from ctmrpim.problem.case import Case
+from studies.sweep import CaseSpec
 
 from .base import finished, new_figure
 
@@ -18,7 +18,7 @@ NAME = "plate_hole_convergence"
 TITLE = "Plate with a hole (Kirsch)"
 QUICK_SPACINGS = [0.5, 0.25]
 FULL_SPACINGS = [0.5, 0.25, 0.125, 0.0625]
-METHODS = [("ctm-rpim", "q1"), ("fem", "p1"), ("fem", "p2")]
+METHODS = [("ctm-rpim", None), ("fem", "p1"), ("fem", "p2")]
 PLANES = {"stress": 1, "strain": 0}   # the problem file's `ps` parameter must follow problem.plane
 
 

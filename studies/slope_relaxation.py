@@ -13,7 +13,7 @@ import sys
 
 import pandas as pd
 
-from ctmrpim.sweep import CaseSpec
+from studies.sweep import CaseSpec, element_of
 
 from .base import finished, new_figure
 
@@ -27,7 +27,7 @@ SOLVER = ('strength-reduction.solver="dynamic-relaxation"', "dynamic.steps=3000"
 def specs(quick: bool) -> list[CaseSpec]:
     p = QUICK if quick else FULL
     return [CaseSpec("slope", (f"parameters.h={p['h']!r}", f"strength-reduction.values=[{s!r}]", *SOLVER), solver,
-                     "p2", labels=(("srf", s),)) for s in p["srf"] for solver in ("ctm-rpim", "fem")]
+                     element_of(solver, "p2"), labels=(("srf", s),)) for s in p["srf"] for solver in ("ctm-rpim", "fem")]
 
 
 def extra(summary: dict) -> dict:

@@ -15,8 +15,8 @@ import meshio
 import numpy as np
 import pandas as pd
 
-from ctmrpim.output import read_pvd
-from ctmrpim.sweep import CaseSpec
+from ctmrpim.io.vtu import read_pvd
+from studies.sweep import CaseSpec
 
 NAME = "slope_slide"
 TITLE = "Slope at SRF = 1.6: the slide at large deformation (cf. Fig. 21)"

@@ -10,7 +10,7 @@ import sys
 
 import pandas as pd
 
-from ctmrpim.sweep import CaseSpec
+from studies.sweep import CaseSpec, element_of
 
 from .base import finished, new_figure
 
@@ -22,7 +22,7 @@ FULL = {"h": 0.58, "srf": [0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.35, 1.4, 1.5, 1.6]}
 
 def specs(quick: bool) -> list[CaseSpec]:
     p = QUICK if quick else FULL
-    return [CaseSpec("slope", (f"parameters.h={p['h']!r}", f"strength-reduction.values=[{s!r}]"), solver, "p2",
+    return [CaseSpec("slope", (f"parameters.h={p['h']!r}", f"strength-reduction.values=[{s!r}]"), solver, element_of(solver, "p2"),
                      labels=(("srf", s),)) for s in p["srf"] for solver in ("ctm-rpim", "fem")]
 
 

@@ -17,8 +17,8 @@ from functools import cache
 import pandas as pd
 
 from ctmrpim import benchmarks
-from ctmrpim.limit_equilibrium import problem_factor_of_safety
-from ctmrpim.sweep import CaseSpec
+from ctmrpim.reference.limit_equilibrium import problem_factor_of_safety
+from studies.sweep import CaseSpec, element_of
 
 from .base import finished, new_figure
 
@@ -35,7 +35,7 @@ def bishop(target: str) -> float:
 
 def specs(quick: bool) -> list[CaseSpec]:
     mode = "quick" if quick else "full"
-    return [CaseSpec(target, (f"parameters.h={h!r}",), solver, "p2", labels=(("slope", target), ("h", h)))
+    return [CaseSpec(target, (f"parameters.h={h!r}",), solver, element_of(solver, "p2"), labels=(("slope", target), ("h", h)))
             for target, hs in SPACING.items() for h in hs[mode] for solver in ("ctm-rpim", "fem")]
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ctmrpim import benchmarks
-from ctmrpim.solvers import solve
+from ctmrpim.methods import solve
 
 from .base import new_figure, save_figure
 

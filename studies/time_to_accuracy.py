@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pandas as pd
 
-from ctmrpim.sweep import CaseSpec
+from studies.sweep import CaseSpec
 
 from .base import finished, new_figure
 
@@ -18,7 +18,7 @@ NAME = "time_to_accuracy"
 TITLE = "Time to accuracy (cantilever tip error)"
 TARGETS = (1e-2, 1e-3, 1e-4)
 GRIDS = {  # (quick, full) node grids per method; FEM is cheap, so it goes finer
-    ("ctm-rpim", "q1"): ([(17, 5), (33, 9), (65, 17)], [(17, 5), (33, 9), (65, 17), (129, 33), (257, 65)]),
+    ("ctm-rpim", None): ([(17, 5), (33, 9), (65, 17)], [(17, 5), (33, 9), (65, 17), (129, 33), (257, 65)]),
     ("fem", "q1"): ([(17, 5), (33, 9), (65, 17), (129, 33)],
                     [(17, 5), (33, 9), (65, 17), (129, 33), (257, 65), (513, 129)]),
     ("fem", "p1"): ([(33, 9), (65, 17), (129, 33)], [(33, 9), (65, 17), (129, 33), (257, 65), (513, 129)]),

@@ -4,9 +4,9 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from ctmrpim.geometry import Geometry, Shape
-from ctmrpim.method import mean_node_spacing
-from ctmrpim.nodes import NodeSpec, make_nodes
+from ctmrpim.problem.geometry import Geometry, Shape
+from ctmrpim.problem.node_cloud import mean_node_spacing
+from ctmrpim.problem.node_cloud import NodeSpec, make_nodes
 
 GEOMETRIES = {
     "rectangle": Geometry([Shape("rectangle", (0.0, 0.0, 4.0, 1.0))]),

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from clouds import GEOMETRIES, HOLES, cloud
-from ctmrpim.alpha_shape import _loops, alpha_shape, signed_area
+from ctmrpim.discretisation.alpha_shape import _loops, alpha_shape, signed_area
 from ctmrpim.errors import ProblemError
-from ctmrpim.tolerances import entry
+from studies.tolerances import entry
 
 ROUNDOFF = entry("roundoff")["max"]
 

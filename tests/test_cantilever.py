@@ -6,7 +6,7 @@ import pytest
 from verify import check, check_rate
 
 from ctmrpim import benchmarks
-from ctmrpim.linear_static import solve_ctmrpim
+from ctmrpim.solvers.linear_static import solve_ctmrpim
 from ctmrpim.result import Result
 
 GRIDS = ((17, 5), (33, 9), (65, 17))

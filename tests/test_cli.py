@@ -11,8 +11,9 @@ import meshio
 import numpy as np
 import pytest
 
-from ctmrpim import benchmarks, tolerances
-from ctmrpim.linear_static import solve_ctmrpim
+from ctmrpim import benchmarks
+from studies import tolerances
+from ctmrpim.solvers.linear_static import solve_ctmrpim
 from ctmrpim.result import Result
 
 SCRIPT = Path(sys.executable).with_name("ctmrpim")   # the console script of the environment under test

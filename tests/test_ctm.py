@@ -7,8 +7,8 @@ import shapely
 from shapely.geometry import Polygon
 
 from clouds import GEOMETRIES
-from ctmrpim.ctm import boundary_points, integration_points
-from ctmrpim.tolerances import entry
+from ctmrpim.discretisation.ctm import boundary_points, integration_points
+from studies.tolerances import entry
 
 ROUNDOFF = entry("roundoff")["max"]
 MONOMIALS = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)]

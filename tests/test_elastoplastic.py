@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 from verify import check
 
-import ctmrpim.elastoplastic as elastoplastic
-from ctmrpim.cli import load_target
-from ctmrpim.linear_static import Timer
+import ctmrpim.solvers.elastoplastic as elastoplastic
+from ctmrpim.cases import load_case
+from ctmrpim.timing import Timer
 
 BLOCK = Path(__file__).parent / "data" / "mc_block.toml"
 
 
 def plateau_reaction(phi: float, psi: float = 0.0) -> tuple[float, float, object]:
-    case = load_target(str(BLOCK), [f"parameters.phi={phi!r}", f"material.psi={psi!r}"])
+    case = load_case(str(BLOCK), [f"parameters.phi={phi!r}", f"material.psi={psi!r}"])
     mat = case.problem.material
     system, _ = elastoplastic.ctm_plastic_system(case, Timer())
     system.run(case.loading, lambda t: mat, lambda t: t, lambda t, U: {})
@@ -29,7 +29,7 @@ def plateau_reaction(phi: float, psi: float = 0.0) -> tuple[float, float, object
 
 
 def system_points(case) -> np.ndarray:
-    from ctmrpim.linear_static import discretise
+    from ctmrpim.discretisation.configuration import discretise
     return discretise(case, Timer()).nodes[:, 1]
 
 
@@ -53,4 +53,4 @@ def test_bad_mohr_coulomb_input_names_the_key(tmp_path, change, message: str) ->
     path = tmp_path / "block.toml"
     path.write_text(change(BLOCK.read_text()))
     with pytest.raises(ProblemError, match=message):
-        load_target(str(path), [])
+        load_case(str(path), [])

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 from verify import check
 
-from ctmrpim import benchmarks, elastica
+from ctmrpim import benchmarks
+from ctmrpim.reference import elastica
 from ctmrpim.errors import ProblemError
-from ctmrpim.solvers import solve
+from ctmrpim.methods import solve
 
 L = 10.0
 
@@ -29,8 +30,9 @@ def test_follower_loads_need_a_large_deformation_analysis() -> None:
 def test_face_follower_tractions_stay_a_couple() -> None:
     """follower = "face": both half-face tractions turn with the chord of the whole end face, so at
     any displacement their nodal forces sum to zero (a pure couple) and turn rigidly."""
-    from ctmrpim.boundary_loads import BoundaryLoads
-    from ctmrpim.linear_static import Timer, build_configuration
+    from ctmrpim.discretisation.boundary_loads import BoundaryLoads
+    from ctmrpim.timing import Timer
+    from ctmrpim.discretisation.configuration import build_configuration
 
     case = benchmarks.load("end-moment", ["parameters.m=0.25"])
     conf = build_configuration(case, Timer())
@@ -67,7 +69,7 @@ def test_fem_p2_end_moment_with_face_followers() -> None:
 def test_follower_values(value, ok: bool) -> None:
     import tomllib
 
-    from ctmrpim.problem_file import parse_case
+    from ctmrpim.problem.problem_file import parse_case
 
     raw = tomllib.loads(benchmarks.path("end-moment").read_text())
     raw["traction"][0]["follower"] = value

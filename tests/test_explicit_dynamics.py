@@ -16,13 +16,13 @@ import pytest
 
 from ctmrpim import benchmarks
 from ctmrpim.errors import ProblemError
-from ctmrpim.explicit_dynamics import ExplicitRun, input_key, solve_explicit
-from ctmrpim.explicit_point_update import point_update
-from ctmrpim.lumped_mass import lumped_mass
-from ctmrpim.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, MohrCoulomb, plastic_strain_increment
-from ctmrpim.objective_stress import (det2, det_c, first_piola_c, hughes_winget, hughes_winget_c, inv2,
-                                      largest_strain, largest_strain_c, relative_c, rotate_c)
-from ctmrpim.walls import Wall, enforce_walls
+from ctmrpim.solvers.explicit.run import ExplicitRun, input_key, solve_explicit
+from ctmrpim.materials.mohr_coulomb_kernel import point_update
+from ctmrpim.discretisation.lumped_mass import lumped_mass
+from ctmrpim.materials.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, MohrCoulomb, plastic_strain_increment
+from ctmrpim.materials.objective_stress import det2, det_c, first_piola_c, hughes_winget, hughes_winget_c, inv2, largest_strain, largest_strain_c, relative_c, rotate_c
+from ctmrpim.problem.model import Wall
+from ctmrpim.solvers.explicit.contact import enforce_walls
 
 QUICK = ["nodes.grid=[16, 9]", "method.alpha=2.0"]
 
@@ -301,13 +301,13 @@ def test_walls_need_explicit_dynamics(tmp_path):
     text = text.replace('model = "mohr-coulomb"', 'model = "linear-elastic"')
     f = tmp_path / "p.toml"
     f.write_text(text)
-    from ctmrpim.problem_file import load_case
+    from ctmrpim.problem.problem_file import read_case
     with pytest.raises(ProblemError, match="explicit"):
-        load_case(f)
+        read_case(f)
 
 
 def test_deposit_measures_of_known_shapes():
-    from ctmrpim.deposit import curve_distance, failure_line, run_out, slope_angle, surface_profile
+    from ctmrpim.reference.deposit import curve_distance, failure_line, run_out, slope_angle, surface_profile
     # a trapezoid deposit: 0.1 high at the wall, falling linearly to 0 at x = 0.4
     pts = np.array([[0.0, 0.0], [0.4, 0.0], [0.0, 0.1]])
     edges = np.array([[0, 1], [1, 2], [2, 0]])
@@ -324,7 +324,7 @@ def test_deposit_measures_of_known_shapes():
 
 
 def test_series_writer_round_trip(tmp_path):
-    from ctmrpim.output import SeriesWriter, read_pvd
+    from ctmrpim.io.vtu import SeriesWriter, read_pvd
     writer = SeriesWriter(tmp_path)
     pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     for t in (0.0, 0.5):
@@ -338,7 +338,7 @@ def test_series_writer_round_trip(tmp_path):
 
 
 def test_supports_widen_to_min_nodes_and_singular_points_are_dropped():
-    from ctmrpim.rpim import shape_functions
+    from ctmrpim.discretisation.rpim import shape_functions
     rng = np.random.default_rng(0)
     nodes = rng.random((60, 2))
     far = np.array([[3.0, 3.0]])                   # no node within the radius

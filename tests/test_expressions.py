@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ctmrpim.errors import ProblemError
-from ctmrpim.expressions import Expression, Field, constant
+from ctmrpim.problem.expressions import Expression, Field, constant
 
 X = np.array([-2.0, -0.5, 0.0, 0.25, 1.0, 3.0])
 Y = np.array([1.0, 2.0, -1.0, 0.5, -3.0, 0.75])

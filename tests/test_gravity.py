@@ -9,7 +9,7 @@ from verify import check
 
 from ctmrpim import benchmarks
 from ctmrpim.errors import ProblemError
-from ctmrpim.solvers import solve
+from ctmrpim.methods import solve
 
 
 def test_self_weight_ctmrpim_and_fem() -> None:

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from verify import check
 
-from ctmrpim.hyperelastic import NeoHookean
+from ctmrpim.materials.neo_hookean import NeoHookean
 
 MAT = NeoHookean(E=2.0e5, nu=0.3)
 

@@ -7,7 +7,7 @@ import pytest
 import shapely
 from verify import check
 
-from ctmrpim.limit_equilibrium import bishop, critical_circle, top_surface
+from ctmrpim.reference.limit_equilibrium import bishop, critical_circle, top_surface
 
 EMBANKMENT = np.array([[0, 15], [20, 15], [40, 5], [60, 5]], float)    # Smith & Griffiths 6.4, base y = 0
 GRIFFITHS_LANE = np.array([[0, 10], [12, 10], [32, 0]], float)         # Griffiths & Lane (1999) Ex. 1
@@ -39,7 +39,7 @@ def test_top_surface_of_a_polygon() -> None:
 
 
 def test_top_surface_of_a_problem_geometry() -> None:
-    from ctmrpim.geometry import Geometry, Shape
+    from ctmrpim.problem.geometry import Geometry, Shape
 
     g = Geometry(add=[Shape("polygon", [(0, 0), (32, 0), (12, 10), (0, 10)])])
     assert np.allclose(top_surface(g), GRIFFITHS_LANE)

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ctmrpim.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, TENSION, MohrCoulomb, _principal
+from ctmrpim.materials.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, TENSION, MohrCoulomb, _principal
 
 E, NU, C = 1.0e8, 0.3, 1.0e4
 ON_SURFACE = 1e-9           # |f| / (c + max |sigma|) after a return: round-off

@@ -4,7 +4,7 @@ from __future__ import annotations
 import pytest
 from verify import check
 
-from ctmrpim.linear_static import solve_ctmrpim
+from ctmrpim.solvers.linear_static import solve_ctmrpim
 from reference_fem import solve_fem
 from studies.plate_hole_convergence import PLANES, case
 

@@ -11,10 +11,10 @@ from scipy.spatial import cKDTree
 
 from ctmrpim import benchmarks
 from ctmrpim.errors import ProblemError
-from ctmrpim.geometry import CIRCLE_SAGITTA, Geometry, Shape, circle_segments
-from ctmrpim.method import Method
-from ctmrpim.nodes import NodeSpec, check_nodes_inside, make_nodes
-from ctmrpim.problem_file import apply_overrides, load_case
+from ctmrpim.problem.geometry import CIRCLE_SAGITTA, Geometry, Shape, circle_segments
+from ctmrpim.problem.settings import Method
+from ctmrpim.problem.node_cloud import NodeSpec, check_nodes_inside, make_nodes
+from ctmrpim.problem.problem_file import apply_overrides, read_case
 
 MINIMAL = """
 [problem]
@@ -109,7 +109,7 @@ def test_override_unknown_key_suggests() -> None:
 
 
 def test_defaults_are_recorded(tmp_path: Path) -> None:
-    case = load_case(write(tmp_path, MINIMAL))
+    case = read_case(write(tmp_path, MINIMAL))
     assert set(case.defaults) == {
         "problem.analysis = 'linear'", "problem.plane = 'stress'", "problem.thickness = 1.0",
         "problem.gravity = [0.0, 0.0]", "material.density = 0.0",
@@ -118,14 +118,14 @@ def test_defaults_are_recorded(tmp_path: Path) -> None:
     assert case.resolved["problem"] == {"name": "plate", "analysis": "linear", "plane": "stress", "thickness": 1.0,
                                         "gravity": [0.0, 0.0]}
     assert case.resolved["material"]["density"] == 0.0
-    given = load_case(write(tmp_path, MINIMAL + "\n[method]\neta = 3.0\n"))
+    given = read_case(write(tmp_path, MINIMAL + "\n[method]\neta = 3.0\n"))
     assert "method.eta = 5.0" not in given.defaults and given.method.eta == 3.0
 
 
 def test_parameters_are_evaluated_in_order(tmp_path: Path) -> None:
     text = MINIMAL.replace("[geometry]", '[parameters]\na = 2\nb = "3*a"\nc = "hypot(a, b) - sqrt(40)"\n\n[geometry]')
     text = text.replace("rectangle = [0, 0, 10, 2]", 'rectangle = [0, 0, "b + 4", "a"]')
-    case = load_case(write(tmp_path, text))
+    case = read_case(write(tmp_path, text))
     assert case.problem.parameters == {"a": 2.0, "b": 6.0, "c": pytest.approx(0.0, abs=1e-14)}
     assert case.problem.geometry.bounds == (0.0, 0.0, 10.0, 2.0)
 
@@ -216,7 +216,7 @@ def test_nodes_from_csv(tmp_path: Path) -> None:
     rows = "\n".join(f"{float(x)!r}, {float(y)!r}" for x, y in zip(X.ravel(), Y.ravel()))
     (tmp_path / "cloud.csv").write_text("x, y\n" + rows)
     text = MINIMAL.replace("grid = [11, 3]", 'file = "cloud.csv"')
-    case = load_case(write(tmp_path, text))      # the CSV path is relative to the problem file
+    case = read_case(write(tmp_path, text))      # the CSV path is relative to the problem file
     assert case.nodes == NodeSpec(file="cloud.csv") and case.base_dir == tmp_path
     nodes = make_nodes(case.problem.geometry, case.nodes, case.base_dir)
     np.testing.assert_array_equal(nodes, np.c_[X.ravel(), Y.ravel()])
@@ -230,7 +230,7 @@ def test_nodes_from_csv(tmp_path: Path) -> None:
 ])
 def test_bad_csv(tmp_path: Path, content: str, match: str) -> None:
     (tmp_path / "cloud.csv").write_text(content)
-    case = load_case(write(tmp_path, MINIMAL.replace("grid = [11, 3]", 'file = "cloud.csv"')))
+    case = read_case(write(tmp_path, MINIMAL.replace("grid = [11, 3]", 'file = "cloud.csv"')))
     with pytest.raises(ProblemError, match=match) as info:
         make_nodes(case.problem.geometry, case.nodes, case.base_dir)
     assert info.value.key == "nodes.file"

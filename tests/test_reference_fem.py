@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 from verify import check, check_rate
 
-from ctmrpim import benchmarks, tolerances
+from ctmrpim import benchmarks
+from studies import tolerances
 from ctmrpim.errors import ProblemError
-from ctmrpim.nodes import make_nodes
+from ctmrpim.problem.node_cloud import make_nodes
 from ctmrpim.result import Result
 from reference_fem import solve_fem
 

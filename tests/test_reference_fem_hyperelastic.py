@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 from verify import check
 
-from ctmrpim import benchmarks, elastica
+from ctmrpim import benchmarks
+from ctmrpim.reference import elastica
 from ctmrpim.errors import ProblemError
-from ctmrpim.solvers import solve
+from ctmrpim.methods import solve
 from reference_fem.hyperelastic import solve_fem_hyperelastic
 
 L = 10.0

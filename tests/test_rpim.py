@@ -7,8 +7,8 @@ from scipy.interpolate import RBFInterpolator
 
 from clouds import cloud
 from ctmrpim.errors import ProblemError
-from ctmrpim.rpim import shape_functions
-from ctmrpim.tolerances import entry
+from ctmrpim.discretisation.rpim import shape_functions
+from studies.tolerances import entry
 
 ROUNDOFF = entry("roundoff")["max"]
 

@@ -12,13 +12,14 @@ from scipy.sparse.linalg import spsolve
 from verify import check
 
 from ctmrpim import benchmarks
-from ctmrpim.elastoplastic import block_rows, ctm_plastic_system
+from ctmrpim.solvers.plastic_system import block_rows
+from ctmrpim.solvers.elastoplastic import ctm_plastic_system
 from ctmrpim.errors import ProblemError
-from ctmrpim.linear_static import Timer
-from ctmrpim.load_stepping import Anderson
-from ctmrpim.mohr_coulomb import MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
-from ctmrpim.solvers import solve
-from ctmrpim.strength_reduction import bracket, reduced
+from ctmrpim.timing import Timer
+from ctmrpim.solvers.load_stepping import Anderson
+from ctmrpim.materials.mohr_coulomb import MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
+from ctmrpim.methods import solve
+from ctmrpim.solvers.strength_reduction import bracket, reduced
 
 BISHOP = {"slope": 1.368, "slope-gl": 1.378}
 PRANDTL = (2.0 + math.pi) * 100e3
@@ -31,7 +32,7 @@ def results() -> dict:
 
 def _solved(results: dict, name: str, solver: str):
     if (name, solver) not in results:
-        results[name, solver] = solve(benchmarks.load(name), solver, "p2")
+        results[name, solver] = solve(benchmarks.load(name), solver, None if solver == "ctm-rpim" else "p2")
     return results[name, solver]
 
 
@@ -62,7 +63,7 @@ def shear_band_connects_crest_and_toe(points: np.ndarray, plastic: np.ndarray, p
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
 
-    from ctmrpim.limit_equilibrium import top_surface
+    from ctmrpim.reference.limit_equilibrium import top_surface
     surface = top_surface(problem.geometry)
     crest, toe = surface[1], surface[-2] if len(surface) > 3 else surface[-1]   # the slope's upper and lower ends
     band = np.flatnonzero(plastic > 0.3 * np.percentile(plastic, 99))
@@ -109,7 +110,7 @@ def test_reduced_strength_follows_eqs_38_39() -> None:
 
 
 def test_bracket_takes_the_largest_stable_below_the_smallest_failed() -> None:
-    from ctmrpim.strength_reduction import Level
+    from ctmrpim.solvers.strength_reduction import Level
     levels = [Level(s, ok, 0, 0, 0.0, ()) for s, ok in [(1.0, True), (1.4, False), (1.3, True), (1.5, True)]]
     assert bracket(levels) == (1.3, 1.4)
     assert bracket(levels[:1]) == (1.0, None)
@@ -185,7 +186,8 @@ def test_until_failure_needs_a_mohr_coulomb_quasi_static_analysis() -> None:
 def test_dynamic_relaxation_comes_to_rest_at_the_elastic_solution() -> None:
     """A strong Mohr-Coulomb column under its own weight stays elastic: relaxed to rest it matches the
     linear solve of the same CTM-RPIM discretisation (the exact K0 column within the method's error)."""
-    from ctmrpim.dynamic_relaxation import Relaxation, relax, relaxation_mass
+    from ctmrpim.problem.settings import Relaxation
+    from ctmrpim.solvers.dynamic_relaxation import relax, relaxation_mass
     case = benchmarks.load("self-weight", ['problem.analysis="dynamic"', 'material.model="mohr-coulomb"',
                                            "material.c=1e9", "material.phi=30"])
     system, _ = ctm_plastic_system(case, Timer())
@@ -228,9 +230,9 @@ def test_limit_pressure_is_the_same_for_a_traction_and_a_pressure(tmp_path) -> N
     text = benchmarks.path("footing").read_text()
     path = tmp_path / "footing_pressure.toml"
     path.write_text(text.replace("[[traction]]", "[[pressure]]").replace('ty = "-q_max"', 'p = "q_max"'))
-    from ctmrpim.cli import load_target
+    from ctmrpim.cases import load_case
     coarse = ["parameters.nx=25", "parameters.ny=11"]
-    with_pressure = solve(load_target(str(path), coarse), "fem", "p2").outcome["limit_pressure"]
+    with_pressure = solve(load_case(str(path), coarse), "fem", "p2").outcome["limit_pressure"]
     with_traction = solve(benchmarks.load("footing", coarse), "fem", "p2").outcome["limit_pressure"]
     assert with_pressure == pytest.approx(with_traction, rel=1e-9)
     assert with_pressure["carried"] == pytest.approx(PRANDTL, rel=0.03)

@@ -6,7 +6,7 @@ import pytest
 from verify import check
 
 import studies
-from ctmrpim.sweep import Sweep
+from studies.sweep import Sweep
 from studies import claims
 
 
@@ -25,7 +25,7 @@ def tables(tmp_path_factory, sweep) -> dict[str, pd.DataFrame]:
 def test_quick_report(tables, sweep, tmp_path) -> None:
     """The main job: every section and figure is written and every check passes (the studies' cases
     come from the shared cache, so this only adds the report's own work)."""
-    from ctmrpim.report import make_report
+    from studies.report import make_report
 
     path = make_report(quick=True, out_dir=tmp_path, sweep=sweep, progress=lambda *_: None)
     text = path.read_text()

@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from ctmrpim.sweep import CaseSpec, Sweep, case_hash
+from studies.sweep import CaseSpec, Sweep, case_hash
 
 SPECS = [CaseSpec("cantilever", ("nodes.grid=[17, 5]", f"method.eta={eta}"), labels=(("eta", eta),))
          for eta in (3.5, 5.0, 6.5)] + [CaseSpec("cantilever", ("nodes.grid=[17, 5]",), "fem", "q1")]

@@ -6,12 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ctmrpim.cli import load_target
-from ctmrpim.hyperelastic import NeoHookean
-from ctmrpim.objective_stress import (LeftCauchyGreenUpdate, HypoelasticUpdate, complex_step_tangent,
-                                      hughes_winget)
-from ctmrpim.state_transfer import project_to_nodes, transfer
-from ctmrpim.updated_lagrangian import adaptive_body
+from ctmrpim.cases import load_case
+from ctmrpim.materials.neo_hookean import NeoHookean
+from ctmrpim.materials.objective_stress import LeftCauchyGreenUpdate, HypoelasticUpdate, complex_step_tangent, hughes_winget
+from ctmrpim.discretisation.state_transfer import project_to_nodes, transfer
+from ctmrpim.solvers.updated_lagrangian import adaptive_body
 
 E = 1.0e9
 BLOCK = f"""
@@ -45,7 +44,7 @@ def rotation(theta: float) -> np.ndarray:
 def body_of(tmp_path, model: str = "linear-elastic"):
     path = tmp_path / "block.toml"
     path.write_text(BLOCK.replace("MODEL", model))
-    return adaptive_body(load_target(str(path), []))[0]
+    return adaptive_body(load_case(str(path), []))[0]
 
 
 def rotate(body, degrees: float, increments: int) -> list[tuple[float, int]]:
@@ -137,8 +136,9 @@ L = 10.0
 def test_tip_load_updated_lagrangian_against_the_elastica() -> None:
     from verify import check
 
-    from ctmrpim import benchmarks, elastica
-    from ctmrpim.solvers import solve
+    from ctmrpim import benchmarks
+    from ctmrpim.reference import elastica
+    from ctmrpim.methods import solve
 
     r = solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=6", UL]))
     exact = elastica.tip_load_elliptic(1.2)
@@ -154,8 +154,9 @@ def test_tip_load_updated_lagrangian_against_the_elastica() -> None:
 def test_end_moment_quarter_updated_lagrangian() -> None:
     from verify import check
 
-    from ctmrpim import benchmarks, elastica
-    from ctmrpim.solvers import solve
+    from ctmrpim import benchmarks
+    from ctmrpim.reference import elastica
+    from ctmrpim.methods import solve
 
     r = solve(benchmarks.load("end-moment", ["parameters.m=0.25", "loading.steps=16", UL]))
     x, y = 1.0 + r.probes["tip"]["ux"] / L, r.probes["tip"]["uy"] / L
@@ -169,8 +170,9 @@ def test_corner_point_load_updated_lagrangian() -> None:
     """The paper's corner load as a material point carried by the RPIM interpolation of each increment."""
     from verify import check
 
-    from ctmrpim import benchmarks, elastica
-    from ctmrpim.solvers import solve
+    from ctmrpim import benchmarks
+    from ctmrpim.reference import elastica
+    from ctmrpim.methods import solve
 
     r = solve(benchmarks.load("tip-load-corner", ["parameters.lam=1.8", "loading.steps=8", UL]))
     w = -r.probes["tip"]["uy"] / L
@@ -184,8 +186,8 @@ def test_series_carries_the_tracked_boundary(tmp_path) -> None:
     import meshio
 
     from ctmrpim import benchmarks
-    from ctmrpim.cli import write_outputs
-    from ctmrpim.solvers import solve
+    from ctmrpim.io.run_folder import write_outputs
+    from ctmrpim.methods import solve
 
     case = benchmarks.load("tip-load", ["parameters.lam=0.6", "loading.steps=2", UL])
     r = solve(case)
@@ -202,8 +204,9 @@ def test_carried_points_keep_their_state() -> None:
     boundary and the RPIM shape functions still rebuilt every increment."""
     from verify import check
 
-    from ctmrpim import benchmarks, elastica
-    from ctmrpim.solvers import solve
+    from ctmrpim import benchmarks
+    from ctmrpim.reference import elastica
+    from ctmrpim.methods import solve
 
     r = solve(benchmarks.load("end-moment", ["parameters.m=0.25", "loading.steps=16", UL,
                                              "method.point_regeneration=0.5"]))
@@ -215,7 +218,7 @@ def test_carried_points_keep_their_state() -> None:
 
 def test_points_are_laid_anew_once_strained_past_the_threshold() -> None:
     from ctmrpim import benchmarks
-    from ctmrpim.solvers import solve
+    from ctmrpim.methods import solve
 
     r = solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=6", UL, "method.point_regeneration=0.02"]))
     assert r.counts["rebuilds"] == 5 and 0 < r.counts["state_transfers"] < 5

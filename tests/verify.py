@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ctmrpim import tolerances
+from studies import tolerances
 from studies.fitting import fitted_rate
 
 

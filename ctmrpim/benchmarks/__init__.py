@@ -7,8 +7,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import ProblemError
-from ..problem_file import Case, load_case
+from ctmrpim.errors import ProblemError
+from ctmrpim.problem.case import Case
+from ctmrpim.problem.problem_file import read_case
 
 FOLDER = Path(__file__).parent
 
@@ -25,7 +26,7 @@ def path(name: str) -> Path:
 
 
 def load(name: str, overrides: list[str] | None = None) -> Case:
-    return load_case(path(name), overrides)
+    return read_case(path(name), overrides)
 
 
 def data(folder: str, name: str):

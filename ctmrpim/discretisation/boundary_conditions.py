@@ -1,0 +1,121 @@
+"""Boundary conditions on a node cloud: `where` selectors evaluated into node and segment tags.
+
+Selectors are evaluated once, on the reference configuration: constraints select boundary nodes,
+tractions and pressures select boundary segments whose two end nodes both match (so a corner node
+alone never loads the adjacent face). A selector that matches nothing is an error, and so is a
+prescribed value that is not a finite number (``9**9**9`` evaluates to inf) or a part of the body
+without any constrained node (its stiffness is singular; the sparse solver does not always notice).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import shapely
+from scipy.sparse.csgraph import connected_components
+
+from ctmrpim.discretisation.assembly import dof
+from ctmrpim.discretisation.ctm import BoundaryQuadrature, boundary_points
+from ctmrpim.errors import ProblemError
+from ctmrpim.problem.expressions import Field
+from ctmrpim.problem.model import Problem
+
+TRACTION_GAUSS_POINTS = 3  # per boundary segment; exact for the cantilever's parabolic shear
+
+
+def constrained_dofs(problem: Problem, nodes: np.ndarray, boundary_nodes: np.ndarray,
+                     tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Fixed dofs (interleaved: 2 node + component) and their values; a later constraint overrides an
+    earlier one."""
+    values: dict[int, float] = {}
+    bx, by = nodes[boundary_nodes, 0], nodes[boundary_nodes, 1]
+    for i, c in enumerate(problem.constraints):
+        sel = boundary_nodes[np.asarray(c.where(bx, by, eq_tol=tol), bool)]
+        if len(sel) == 0:
+            raise ProblemError(f"where = {c.where.text!r} selects no boundary node", key=f"constraint[{i}].where")
+        for comp, f in ((0, c.ux), (1, c.uy)):
+            if f is not None:
+                v = _values(f, nodes[sel, 0], nodes[sel, 1], f"constraint[{i}].{'uy' if comp else 'ux'}")
+                values.update(zip(dof(sel, comp).tolist(), v.tolist()))
+    dofs = np.fromiter(values.keys(), int, len(values))
+    vals = np.fromiter(values.values(), float, len(values))
+    parts = problem.geometry.polygons
+    if len(parts) > 1:  # one loop per part of the body, not per node
+        held = shapely.points(nodes[np.unique(dofs // 2)])
+        for k, part in enumerate(parts):
+            if not (shapely.distance(part, held) <= tol).any():
+                x0, y0, x1, y1 = part.bounds
+                raise ProblemError(f"part {k + 1} of the body, within ({x0:g}, {y0:g}) .. ({x1:g}, {y1:g}), has no "
+                                   "constrained node: it is free to move rigidly", key="constraint")
+    order = np.argsort(dofs)
+    return dofs[order], vals[order]
+
+
+def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol: float
+                    ) -> tuple[BoundaryQuadrature, np.ndarray, np.ndarray]:
+    """Gauss points on every loaded boundary segment and the traction (tx, ty) at each point."""
+    x, y = nodes[:, 0], nodes[:, 1]
+    pts, wts, nrm, tx_all, ty_all, ends, follow, face = [], [], [], [], [], [], [], []
+    loads = [("traction", i, t.where) for i, t in enumerate(problem.tractions)] + \
+            [("pressure", i, p.where) for i, p in enumerate(problem.pressures)]
+    for kind, i, where in loads:
+        match = np.asarray(where(x, y, eq_tol=tol), bool)
+        seg = edges[match[edges[:, 0]] & match[edges[:, 1]]]
+        if len(seg) == 0:
+            raise ProblemError(f"where = {where.text!r} selects no boundary segment", key=f"{kind}[{i}].where")
+        q = boundary_points(nodes[seg], TRACTION_GAUSS_POINTS)
+        px, py = q.points[:, 0], q.points[:, 1]
+        ends.append(np.repeat(seg, TRACTION_GAUSS_POINTS, axis=0))
+        follow.append(np.full(len(px), kind == "traction" and problem.tractions[i].follower))
+        face.append(np.full(len(px), kind == "traction" and problem.tractions[i].follower
+                            and problem.tractions[i].turn == "face"))
+        if kind == "traction":
+            t = problem.tractions[i]
+            tx = _values(t.tx, px, py, f"traction[{i}].tx") if t.tx is not None else np.zeros(len(px))
+            ty = _values(t.ty, px, py, f"traction[{i}].ty") if t.ty is not None else np.zeros(len(px))
+        else:
+            p = _values(problem.pressures[i].p, px, py, f"pressure[{i}].p")
+            tx, ty = -p * q.normals[:, 0], -p * q.normals[:, 1]
+        pts.append(q.points); wts.append(q.weights); nrm.append(q.normals); tx_all.append(tx); ty_all.append(ty)
+    if not pts:
+        empty = BoundaryQuadrature(np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0, int),
+                                   np.zeros((0, 2), int), np.zeros(0, bool), np.zeros((0, 2), int))
+        return empty, np.zeros(0), np.zeros(0)
+    ends_all, face_all = np.concatenate(ends), np.concatenate(face)
+    q = BoundaryQuadrature(np.concatenate(pts), np.concatenate(wts), np.concatenate(nrm), np.zeros(0, int),
+                           ends_all, np.concatenate(follow), _turn_ends(ends_all, face_all, len(nodes)))
+    return q, np.concatenate(tx_all), np.concatenate(ty_all)
+
+
+def _turn_ends(ends: np.ndarray, face: np.ndarray, n_nodes: int) -> np.ndarray:
+    """The node pair each loaded point's follower load turns with: its own segment, or for
+    ``turn = "face"`` the two end nodes of the connected stretch of face-follower boundary it lies on
+    (segments of several tractions that share a node form one face)."""
+    turn = ends.copy()
+    if not face.any():
+        return turn
+    seg = np.unique(ends[face], axis=0)
+    adj = sp.coo_matrix((np.ones(len(seg)), (seg[:, 0], seg[:, 1])), shape=(n_nodes, n_nodes))
+    _, label = connected_components(adj, directed=False)
+    degree = np.bincount(seg.ravel(), minlength=n_nodes)
+    for comp in np.unique(label[seg[:, 0]]):
+        tips = np.flatnonzero((label == comp) & (degree == 1))
+        if len(tips) != 2:
+            raise ProblemError("a follower = \"face\" traction must act on an open stretch of boundary "
+                               f"(found {len(tips)} ends instead of 2); use follower = \"segment\" on closed loops",
+                               key="traction")
+        # orient the chord like the boundary (body on the left): from the stretch's start to its end
+        start = tips[0] if np.isin(tips[0], seg[:, 0]) else tips[1]
+        mine = face & (label[ends[:, 0]] == comp)
+        turn[mine] = [start, tips[1] if start == tips[0] else tips[0]]
+    return turn
+
+
+def _values(f: Field, x: np.ndarray, y: np.ndarray, key: str) -> np.ndarray:
+    """``f`` at the points; a value that is not a finite number is an error naming ``key`` and the
+    first such point (the solver would otherwise report a singular matrix, or return inf)."""
+    v = f(x, y)
+    bad = np.flatnonzero(~np.isfinite(v))
+    if len(bad):
+        j = bad[0]
+        raise ProblemError(f"{f.text!r} is {v[j]} at ({x[j]:g}, {y[j]:g}) ({len(bad)} of {len(v)} points)", key=key)
+    return v

@@ -1,0 +1,49 @@
+"""State transfer across a rebuild of the integration points (DESIGN.md "State under re-tracking").
+
+History lives at the CTM integration points. When the configuration is rebuilt (new boundary, new
+CTM points) each state component s is L2-projected onto the nodal RPIM space over the old points,
+
+    M_c s_nodal = sum_p N_p^T w_p s_p,      M_c = sum_p N_p^T w_p N_p,
+
+(one factorisation, one right-hand side per component) and evaluated at the new points with the new
+shape functions. Fields the RPIM space holds (constants, linear fields: the basis reproduces them)
+come through exactly, a second transfer without motion changes nothing, and a rigid move carries the
+field with it. Projection smooths: solvers count the transfers they make.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+from ctmrpim.errors import ProblemError
+
+
+class NodalProjection:
+    """The L2 projection onto the nodal RPIM space from points with shape-function rows ``N`` (m, n)
+    and quadrature weights (m,): the mass matrix is factorised once, each call is one solve."""
+
+    def __init__(self, N: sp.csr_matrix, weights: np.ndarray) -> None:
+        self.N, self.weights = N, weights
+        try:
+            self.lu = splu((N.T @ sp.diags(weights) @ N).tocsc())
+        except RuntimeError:
+            raise ProblemError("state transfer: the projection's mass matrix is singular (a node has no "
+                               "integration point in its support)") from None
+
+    def __call__(self, values: np.ndarray) -> np.ndarray:
+        """Nodal values (n, k) of ``values`` (m, k) given at the points."""
+        return self.lu.solve(np.asarray(self.N.T @ (values * self.weights[:, None])))
+
+
+def project_to_nodes(N: sp.csr_matrix, weights: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Nodal values (n, k) of the L2 projection of ``values`` (m, k) given at points with shape-function
+    rows ``N`` (m, n) and quadrature weights ``weights`` (m,)."""
+    return NodalProjection(N, weights)(values)
+
+
+def transfer(N_old: sp.csr_matrix, w_old: np.ndarray, values: np.ndarray, N_new: sp.csr_matrix
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """``values`` at the old points, L2-projected and evaluated at the new points; also the nodal values."""
+    nodal = project_to_nodes(N_old, w_old, values)
+    return np.asarray(N_new @ nodal), nodal

@@ -1,0 +1,53 @@
+"""Checkpoints of long explicit runs: everything the next step needs, in float64, in one ``.npz``.
+
+A run resumed from a checkpoint ends in the same state as an uninterrupted run (DESIGN.md): the file
+holds the node positions and velocities, the state at the integration points, the positions the
+current configuration was built on (it is rebuilt from them, bit for bit, on resume), the time step,
+counters, energy accounts and history, and the hash of the resolved input and of the code, so that a
+checkpoint is never resumed with another problem or another solver. It is written atomically: a kill
+during the write leaves the previous checkpoint in place.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ctmrpim.errors import ProblemError
+from ctmrpim.io.atomic import atomic_write
+from ctmrpim.io.summary import to_jsonable
+
+NAME = "checkpoint.npz"
+
+
+def save_checkpoint(folder: Path, key: str, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> Path:
+    path = Path(folder) / NAME
+    payload = {f"a_{k}": np.asarray(v) for k, v in arrays.items()}
+    payload["meta"] = np.array(json.dumps(to_jsonable({**meta, "key": key})))
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "wb") as fh:          # a file object: np.savez would append ".npz" to a path
+            np.savez(fh, **payload)
+
+    atomic_write(path, write)
+    return path
+
+
+def load_checkpoint(folder: Path, key: str) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """(meta, arrays) of the folder's checkpoint, or a ProblemError saying why it cannot be resumed."""
+    path = Path(folder) / NAME
+    if not path.is_file():
+        raise ProblemError(f"no checkpoint to resume in {str(folder)!r} (expected {NAME}); run without --resume",
+                           key="--resume")
+    try:
+        with np.load(path) as data:
+            meta = json.loads(str(data["meta"]))
+            arrays = {k[2:]: data[k] for k in data.files if k.startswith("a_")}
+    except (OSError, ValueError, KeyError) as exc:
+        raise ProblemError(f"the checkpoint {str(path)!r} cannot be read ({exc})", key="--resume") from None
+    if meta.get("key") != key:
+        raise ProblemError(f"the checkpoint in {str(folder)!r} belongs to another problem, setting or code version; "
+                           "run without --resume to start again", key="--resume")
+    return meta, arrays

@@ -1,0 +1,239 @@
+"""Objective stress updates of the updated-Lagrangian path (Section 2.1.3; DESIGN.md "Updated Lagrangian").
+
+An increment moves the body from the configuration x_n (the last rebuild, where the gradients live)
+to x_{n+1} = x_n + du. At each integration point, with L = d(du)/dx_n and the relative deformation
+gradient f = I + L:
+
+* :class:`HypoelasticUpdate` (a rate law, the one plasticity will use): the midpoint gradient
+  G = L (I + L/2)^-1 gives the strain increment de = sym G and the spin dW = skew G; the
+  Hughes-Winget rotation Q = (I - dW/2)^-1 (I + dW/2) rotates the old stress,
+
+      sigma_{n+1} = Q sigma_n Q^T + D de.
+
+  For a rigid rotation increment f = R, G = 2 (R - I)(R + I)^-1 is exactly skew (de = 0) and Q = R
+  exactly, so a rigid rotation in any number of increments leaves a stress-free body stress-free and
+  turns a pre-stressed body's stress with it, to round-off. The stress state is Cauchy
+  (sxx, syy, sxy, szz); szz follows the plane-strain increment (zero in plane stress).
+* :class:`LeftCauchyGreenUpdate` (neo-Hookean in updated form): the state is the left Cauchy-Green
+  tensor, b_{n+1} = f b_n f^T, and the stress the hyperelastic one of b; objective by construction.
+  b is transferred across rebuilds like any state; it is I plus strain-sized terms in the current
+  frame, where the total deformation gradient F also carries the O(1) rotation, which varies along
+  a bent beam. (Transferring F instead gave the same end-moment results to within their scatter;
+  recovering F from the nodes' reference positions, (dX/dx)^-1 on the new cloud, is not the
+  gradient of the discrete field and was dropped: it moved the end-moment tip by up to 0.03 L.)
+
+Both return the first Piola-Kirchhoff stress relative to x_n, P_n = det f sigma f^-T, so the internal
+force and tangent are the total-Lagrangian operators on x_n (:mod:`ctmrpim.lagrangian_operators`).
+Every formula here is analytic in f, so the consistent tangent dP_n/df, the geometric (initial-stress)
+part included, comes exactly from four complex steps (:func:`complex_step_tangent`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ctmrpim.errors import ProblemError
+from ctmrpim.materials.neo_hookean import NeoHookean
+
+#: Complex-step size: the derivative is exact to round-off for any h this small (no subtraction).
+COMPLEX_STEP = 1e-30
+
+
+def det2(a: np.ndarray) -> np.ndarray:
+    return a[:, 0, 0] * a[:, 1, 1] - a[:, 0, 1] * a[:, 1, 0]
+
+
+def inv2(a: np.ndarray) -> np.ndarray:
+    """Inverses of (m, 2, 2) matrices by the explicit formula (analytic: complex steps pass through)."""
+    adj = np.stack([np.stack([a[:, 1, 1], -a[:, 0, 1]], -1), np.stack([-a[:, 1, 0], a[:, 0, 0]], -1)], 1)
+    return adj / det2(a)[:, None, None]
+
+
+def hughes_winget(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Strain increment de = sym G and rotation Q = (I - dW/2)^-1 (I + dW/2), G = L (I + L/2)^-1."""
+    eye = np.eye(2)[None]
+    L = f - eye
+    G = L @ inv2(eye + 0.5 * L)
+    de = 0.5 * (G + G.transpose(0, 2, 1))
+    half_w = 0.25 * (G - G.transpose(0, 2, 1))
+    return de, inv2(eye - half_w) @ (eye + half_w)
+
+
+def largest_strain(F: np.ndarray) -> float:
+    """Largest |principal stretch - 1| over deformation gradients (m, 2, 2) (:func:`largest_strain_c`)."""
+    return largest_strain_c(F.reshape(-1, 4))
+
+
+def check_orientation(f: np.ndarray) -> np.ndarray:
+    """det f, or a ProblemError naming the first point where the increment inverts the material."""
+    J = det2(f.real)
+    if np.any(J <= 0):
+        i = int(np.argmin(J))
+        raise ProblemError(f"det f = {J[i]:.3g} <= 0 at integration point #{i}: the increment inverts the "
+                           "material; use more load steps")
+    return J
+
+
+class HypoelasticUpdate:
+    """Linear elastic rate law, Hughes-Winget objective (state: Cauchy sxx, syy, sxy, szz)."""
+
+    n_state = 4
+
+    def __init__(self, D: np.ndarray, plane: str):
+        self.D = np.asarray(D, float)
+        # szz increment in plane strain: lambda (de_xx + de_yy) = D[0, 1] (de_xx + de_yy)
+        self.zz = self.D[0, 1] if plane == "strain" else 0.0
+
+    def initial(self, m: int) -> np.ndarray:
+        return np.zeros((m, 4))
+
+    def _update(self, f: np.ndarray, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        de, Q = hughes_winget(f)
+        s0 = np.empty((len(state), 2, 2), dtype=state.dtype)
+        s0[:, 0, 0], s0[:, 1, 1] = state[:, 0], state[:, 1]
+        s0[:, 0, 1] = s0[:, 1, 0] = state[:, 2]
+        eps = np.stack([de[:, 0, 0], de[:, 1, 1], 2.0 * de[:, 0, 1]], -1)   # engineering shear
+        ds = eps @ self.D.T
+        sig = Q @ s0 @ Q.transpose(0, 2, 1)
+        sig[:, 0, 0] += ds[:, 0]
+        sig[:, 1, 1] += ds[:, 1]
+        sig[:, 0, 1] += ds[:, 2]
+        sig[:, 1, 0] += ds[:, 2]
+        szz = state[:, 3] + self.zz * (de[:, 0, 0] + de[:, 1, 1])
+        return sig, szz
+
+    def first_piola(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+        sig, _ = self._update(f, state)
+        return det2(f)[:, None, None] * sig @ inv2(f).transpose(0, 2, 1)
+
+    def advance(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+        check_orientation(f)
+        sig, szz = self._update(f, state)
+        return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1], szz]
+
+    def cauchy(self, state: np.ndarray) -> np.ndarray:
+        """(m, 3) sxx, syy, sxy."""
+        return state[:, :3].copy()
+
+
+class LeftCauchyGreenUpdate:
+    """Neo-Hookean in updated form (state: the left Cauchy-Green tensor b = F F^T, xx, yy, xy).
+
+    b_{n+1} = f b_n f^T; Kirchhoff stress tau = mu (b - I) + lambda ln J I with J = sqrt(det b), the
+    same material as :class:`ctmrpim.hyperelastic.NeoHookean` (plane strain, F33 = 1)."""
+
+    n_state = 3
+
+    def __init__(self, material: NeoHookean):
+        self.material = material
+
+    def initial(self, m: int) -> np.ndarray:
+        return np.tile([1.0, 1.0, 0.0], (m, 1))
+
+    @staticmethod
+    def _b(state: np.ndarray) -> np.ndarray:
+        b = np.empty((len(state), 2, 2), dtype=state.dtype)
+        b[:, 0, 0], b[:, 1, 1] = state[:, 0], state[:, 1]
+        b[:, 0, 1] = b[:, 1, 0] = state[:, 2]
+        return b
+
+    def _cauchy(self, b: np.ndarray) -> np.ndarray:
+        J = np.sqrt(det2(b))
+        mu, lam = self.material.mu, self.material.lam
+        tau = mu * (b - np.eye(2)[None]) + (lam * np.log(J))[:, None, None] * np.eye(2)[None]
+        return tau / J[:, None, None]
+
+    def first_piola(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+        b = f @ self._b(state) @ f.transpose(0, 2, 1)
+        return det2(f)[:, None, None] * self._cauchy(b) @ inv2(f).transpose(0, 2, 1)
+
+    def advance(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+        check_orientation(f)
+        b = f @ self._b(state) @ f.transpose(0, 2, 1)
+        return np.c_[b[:, 0, 0], b[:, 1, 1], b[:, 0, 1]]
+
+    def cauchy(self, state: np.ndarray) -> np.ndarray:
+        sig = self._cauchy(self._b(state))
+        return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1]]
+
+
+def complex_step_tangent(update, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+    """(m, 4, 4) A[c, k] = dP_n[c] / df[k], components c, k = 2 i + J, exact to round-off."""
+    m = len(f)
+    A = np.empty((m, 4, 4))
+    fc = f.astype(complex)
+    for k in range(4):
+        i, J = divmod(k, 2)
+        fc[:, i, J] += 1j * COMPLEX_STEP
+        A[:, :, k] = update.first_piola(fc, state).reshape(m, 4).imag / COMPLEX_STEP
+        fc[:, i, J] = f[:, i, J]
+    return A
+
+
+# -- component forms for the explicit solver's step -------------------------------------------------
+# The explicit solver updates tens of thousands of points every step; numpy's batched 2 x 2 matmul is
+# slow for such small matrices, so its step writes the same algebra out in components. A gradient is
+# stored (m, 4) as xx, xy, yx, yy (F[:, 1] = dx/dY); a stress or strain tensor (m, 4) as xx, yy, xy, zz.
+# tests/test_explicit_dynamics.py checks each against the matrix forms above.
+
+def det_c(F: np.ndarray) -> np.ndarray:
+    return F[:, 0] * F[:, 3] - F[:, 1] * F[:, 2]
+
+
+def first_piola_c(stress: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """(m, 4) P = det F sigma F^-T (xX, xY, yX, yY) of Cauchy stresses (m, 4) at gradients F (m, 4)."""
+    sxx, syy, sxy = stress[:, 0], stress[:, 1], stress[:, 2]
+    F00, F01, F10, F11 = F.T
+    return np.stack([sxx * F11 - sxy * F01, sxy * F00 - sxx * F10,
+                     sxy * F11 - syy * F01, syy * F00 - sxy * F10], axis=1)
+
+
+def relative_c(F_new: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """(m, 4) f = F_new F^-1."""
+    J = det_c(F)
+    a00, a01, a10, a11 = F_new.T
+    i00, i01, i10, i11 = F[:, 3] / J, -F[:, 1] / J, -F[:, 2] / J, F[:, 0] / J
+    return np.stack([a00 * i00 + a01 * i10, a00 * i01 + a01 * i11, a10 * i00 + a11 * i10, a10 * i01 + a11 * i11], axis=1)
+
+
+def hughes_winget_components(f00, f01, f10, f11):
+    """The strain increment (exx, eyy, engineering gxy) and the rotation Q = [[c, -s], [s, c]] (c, s) of
+    :func:`hughes_winget` from the components of f: G = L (I + L/2)^-1, Q = (I - W/2)^-1 (I + W/2) with
+    W = skew G. Arithmetic only, so it serves arrays (:func:`hughes_winget_c`) and, compiled, one point
+    at a time (:mod:`ctmrpim.explicit_point_update`)."""
+    L00, L01, L10, L11 = f00 - 1.0, f01, f10, f11 - 1.0
+    A00, A01, A10, A11 = 1.0 + 0.5 * L00, 0.5 * L01, 0.5 * L10, 1.0 + 0.5 * L11
+    det = A00 * A11 - A01 * A10
+    G00 = (L00 * A11 - L01 * A10) / det
+    G01 = (L01 * A00 - L00 * A01) / det
+    G10 = (L10 * A11 - L11 * A10) / det
+    G11 = (L11 * A00 - L10 * A01) / det
+    h = 0.25 * (G01 - G10)                 # W/2 = [[0, h], [-h, 0]]
+    scale = 1.0 / (1.0 + h * h)
+    return G00, G11, G01 + G10, (1.0 - h * h) * scale, -2.0 * h * scale
+
+
+def hughes_winget_c(f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`hughes_winget_components` of gradients f (m, 4): the strain increments (m, 3) and (c, s)."""
+    e0, e1, e2, c, s = hughes_winget_components(f[:, 0], f[:, 1], f[:, 2], f[:, 3])
+    return np.stack([e0, e1, e2], axis=1), c, s
+
+
+def rotate_components(xx, yy, xy, c, s):
+    """The in-plane components of Q t Q^T for Q = [[c, -s], [s, c]] (arrays or, compiled, scalars)."""
+    cc, ss, cs = c * c, s * s, c * s
+    return cc * xx - 2.0 * cs * xy + ss * yy, ss * xx + 2.0 * cs * xy + cc * yy, cs * (xx - yy) + (cc - ss) * xy
+
+
+def rotate_c(state: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Q t Q^T of tensors (m, 4: xx, yy, xy, zz) for Q = [[c, -s], [s, c]]; zz unchanged."""
+    xx, yy, xy = rotate_components(state[:, 0], state[:, 1], state[:, 2], c, s)
+    return np.stack([xx, yy, xy, state[:, 3]], axis=1)
+
+
+def largest_strain_c(F: np.ndarray) -> float:
+    """Largest |principal stretch - 1| over gradients (m, 4), from C = F^T F."""
+    C00, C11 = F[:, 0] ** 2 + F[:, 2] ** 2, F[:, 1] ** 2 + F[:, 3] ** 2
+    C01 = F[:, 0] * F[:, 1] + F[:, 2] * F[:, 3]
+    mean, half = 0.5 * (C00 + C11), np.hypot(0.5 * (C00 - C11), C01)
+    big, small = np.sqrt(mean + half), np.sqrt(np.maximum(mean - half, 0.0))
+    return float(max(np.abs(big - 1.0).max(), np.abs(small - 1.0).max())) if len(F) else 0.0

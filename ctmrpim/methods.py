@@ -1,0 +1,98 @@
+"""The methods that solve a :class:`~ctmrpim.problem.case.Case`, found by name.
+
+Every method registers a solve function here with :func:`register`: CTM-RPIM (``"ctm-rpim"``,
+:mod:`ctmrpim.solvers.meshfree`) and any finite-element reference, which lives in its own package and
+is announced by an entry point of the group ``ctmrpim.methods`` in its distribution's metadata (the
+scikit-fem reference: ``fem = "reference_fem.method"``). Loading the entry point imports the module,
+which registers itself; the core never imports a reference, so a reference can import the core freely.
+:func:`solve` looks the method up and calls it: no chain of ``if``s over method names.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from importlib.metadata import entry_points
+from pathlib import Path
+from typing import Any, Callable
+
+from ctmrpim.errors import ProblemError
+from ctmrpim.problem.case import Case
+from ctmrpim.result import Result
+
+#: entry-point group of methods that live in other packages
+GROUP = "ctmrpim.methods"
+#: the method this package implements
+DEFAULT = "ctm-rpim"
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How a solve reports and where it writes as it goes (explicit dynamics: series and checkpoints)."""
+
+    progress: Callable[[Any], None] = field(default=lambda level: None)   # each strength-reduction level
+    out: Path | None = None          # folder for a long run's series and checkpoints (a temporary one if None)
+    resume: bool = False             # continue from the checkpoint in ``out``
+    progress_bar: bool = False
+
+
+@dataclass(frozen=True)
+class SolutionMethod:
+    """A registered method: ``solve(case, element, options) -> Result``; ``elements`` the element types
+    it offers (the first is the default; empty for a method without elements)."""
+
+    name: str
+    solve: Callable[[Case, str | None, RunOptions], Result]
+    elements: tuple[str, ...] = ()
+    description: str = ""
+
+
+_REGISTRY: dict[str, SolutionMethod] = {}
+
+
+def register(name: str, solve: Callable[[Case, str | None, RunOptions], Result], elements: tuple[str, ...] = (),
+             description: str = "") -> None:
+    """Make ``solve`` available as method ``name`` (registering a name again replaces it)."""
+    _REGISTRY[name] = SolutionMethod(name, solve, tuple(elements), description)
+
+
+def names() -> list[str]:
+    """Every method that can be asked for: registered, this package's, and announced by entry points."""
+    return sorted({DEFAULT, *_REGISTRY, *(ep.name for ep in entry_points(group=GROUP))})
+
+
+def get(name: str) -> SolutionMethod:
+    """The method called ``name``, imported on first use; a ProblemError for an unknown name."""
+    if name not in _REGISTRY:
+        if name == DEFAULT:
+            from ctmrpim.solvers import meshfree  # noqa: F401  (registers "ctm-rpim")
+        else:
+            for ep in entry_points(group=GROUP, name=name):
+                ep.load()
+    if name not in _REGISTRY:
+        raise ProblemError(f"unknown method {name!r}; available: {', '.join(names())}", key="--solver")
+    return _REGISTRY[name]
+
+
+def element_of(method: SolutionMethod, element: str | None) -> str | None:
+    """The element a solve with ``method`` uses: ``element``, or the method's default where None; an
+    element the method does not offer is refused (CTM-RPIM offers none)."""
+    if element is None:
+        return method.elements[0] if method.elements else None
+    if element not in method.elements:
+        offered = f"one of {', '.join(method.elements)}" if method.elements else "none (it has no elements)"
+        raise ProblemError(f"method {method.name!r} has no element {element!r}: it takes {offered}", key="--element")
+    return element
+
+
+def solve(case: Case, method: str = DEFAULT, element: str | None = None, *,
+          progress: Callable[[Any], None] | None = None, out: Path | None = None, resume: bool = False,
+          progress_bar: bool = False) -> Result:
+    """Solve ``case`` with ``method`` (``"ctm-rpim"``, or a reference such as ``"fem"`` with its
+    ``element``, by default the method's first). ``progress`` gets each strength-reduction level as it
+    finishes; an explicit dynamic run writes its time series and checkpoints into ``out`` as it goes
+    (a temporary folder if None), continues from the checkpoint there with ``resume``, and shows a
+    progress bar with ``progress_bar``. An element the method does not offer is refused."""
+    entry = get(method)
+    element = element_of(entry, element)
+    options = RunOptions(progress=progress or (lambda level: None), out=out, resume=resume,
+                         progress_bar=progress_bar)
+    return entry.solve(case, element, options)

@@ -1,0 +1,150 @@
+"""Field nodes for a geometry: a tensor grid, a spacing, or a CSV file.
+
+On a single axis-aligned rectangle ``grid = [nx, ny]`` is the exact tensor grid (the paper's
+17 x 5 ... 257 x 65 clouds). On any other body nodes are placed along every boundary loop at about
+the grid spacing (corners kept, circles snapped onto their true arcs) and a regular grid fills the
+inside, keeping clear of the boundary by at least ``CLEARANCE`` spacings.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from ctmrpim.errors import ProblemError
+from ctmrpim.problem.geometry import Geometry
+
+CLEARANCE = 0.5     # interior grid nodes closer than this (x spacing) to a boundary node are dropped
+CORNER_ANGLE = math.radians(20.0)  # a boundary vertex turning more than this is kept as a node
+
+
+@dataclass(frozen=True)
+class NodeSpec:
+    """Exactly one of ``grid``, ``spacing`` or ``file``."""
+
+    grid: tuple[int, int] | None = None
+    spacing: float | None = None
+    file: str | None = None
+
+    def __post_init__(self) -> None:
+        given = [k for k in ("grid", "spacing", "file") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ProblemError("give exactly one of grid = [nx, ny], spacing = h or file = \"nodes.csv\""
+                               + (f" (got {', '.join(given)})" if given else ""), key="nodes")
+        if self.grid is not None and (len(self.grid) != 2 or min(self.grid) < 2):
+            raise ProblemError(f"grid = {list(self.grid)} needs two integers >= 2", key="nodes.grid")
+        if self.spacing is not None and not self.spacing > 0:
+            raise ProblemError(f"spacing = {self.spacing} must be > 0", key="nodes.spacing")
+
+    def as_dict(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in
+                (("grid", self.grid), ("spacing", self.spacing), ("file", self.file)) if v is not None}
+
+
+def make_nodes(geometry: Geometry, spec: NodeSpec, base_dir: Path | None = None) -> np.ndarray:
+    """Field node coordinates (n, 2) for ``geometry``."""
+    x0, y0, x1, y1 = geometry.bounds
+    if spec.file is not None:
+        return _read_nodes(geometry, Path(base_dir or ".") / spec.file)
+    if spec.grid is not None:
+        nx, ny = spec.grid
+        if geometry.is_rectangle():
+            X, Y = np.meshgrid(np.linspace(x0, x1, nx), np.linspace(y0, y1, ny), indexing="xy")
+            return np.c_[X.ravel(), Y.ravel()]
+        hx, hy = (x1 - x0) / (nx - 1), (y1 - y0) / (ny - 1)
+    else:
+        hx = hy = float(spec.spacing)
+    return _fill(geometry, hx, hy)
+
+
+def _fill(geometry: Geometry, hx: float, hy: float) -> np.ndarray:
+    h = min(hx, hy)
+    x0, y0, x1, y1 = geometry.bounds
+    boundary = np.concatenate([_resample_loop(loop, h) for loop in geometry.loops()])
+    boundary = geometry.snap_to_circles(boundary, tol=1e-3 * h)
+    X, Y = np.meshgrid(np.arange(x0, x1 + 0.5 * hx, hx), np.arange(y0, y1 + 0.5 * hy, hy))
+    grid = np.c_[X.ravel(), Y.ravel()]
+    inside = shapely.contains_xy(geometry.region, grid[:, 0], grid[:, 1])
+    grid = grid[inside]
+    from scipy.spatial import cKDTree  # here, not at the top: it is a quarter of the CLI's start-up time
+
+    d, _ = cKDTree(boundary).query(grid)
+    clear = (d > CLEARANCE * h) & (geometry.distance_to_boundary(grid) > CLEARANCE * h)
+    nodes = np.concatenate([boundary, grid[clear]])
+    if len(nodes) < 3:
+        raise ProblemError(f"node spacing {h:g} is too coarse for this geometry: only {len(nodes)} nodes",
+                           key="nodes")
+    return nodes
+
+
+def _resample_loop(loop: np.ndarray, h: float) -> np.ndarray:
+    """Points along a closed loop at spacing about h, keeping its corners."""
+    nxt = np.roll(loop, -1, axis=0)
+    prv = np.roll(loop, 1, axis=0)
+    a, b = loop - prv, nxt - loop
+    turn = np.abs(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1)))
+    corners = np.flatnonzero(turn > CORNER_ANGLE)
+    if len(corners) == 0:
+        corners = np.array([0])
+    seg = np.linalg.norm(b, axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])  # arc length at each vertex, closing vertex last
+    total = s[-1]
+    ring = shapely.LinearRing(loop)
+    starts = s[corners]
+    ends = np.append(starts[1:], total)
+    counts = np.maximum(1, np.round((ends - starts) / h).astype(int))
+    # arc-length positions: each stretch between corners divided evenly, corner included once
+    pos = np.concatenate([a0 + (a1 - a0) * np.arange(c) / c for a0, a1, c in zip(starts, ends, counts)])
+    pts = shapely.get_coordinates(shapely.line_interpolate_point(ring, pos))
+    return pts
+
+
+def _read_nodes(geometry: Geometry, path: Path) -> np.ndarray:
+    import pandas as pd
+
+    if not path.is_file():
+        raise ProblemError(f"node file {str(path)!r} not found", key="nodes.file")
+    try:
+        table = pd.read_csv(path)
+    except Exception as exc:  # pandas raises many parser error types
+        raise ProblemError(f"cannot read node file {str(path)!r}: {exc}", key="nodes.file") from None
+    cols = {c.strip().lower(): c for c in table.columns}
+    if not {"x", "y"} <= set(cols):
+        raise ProblemError(f"node file {str(path)!r} needs columns x and y (has {list(table.columns)})",
+                           key="nodes.file")
+    # coerce rather than cast: a cell like "a" must end in the message below, not in a ValueError
+    xy = table[[cols["x"], cols["y"]]].apply(pd.to_numeric, errors="coerce")
+    nodes = xy.to_numpy(dtype=float)
+    bad = np.flatnonzero(~np.isfinite(nodes).all(axis=1))
+    if len(bad):
+        raise ProblemError(f"node file {str(path)!r} holds non-numbers, first in data row {bad[0] + 1}",
+                           key="nodes.file")
+    if len(nodes) < 3:
+        raise ProblemError(f"node file {str(path)!r} holds {len(nodes)} node(s); a body needs at least 3",
+                           key="nodes.file")
+    return nodes
+
+
+def check_nodes_inside(geometry: Geometry, nodes: np.ndarray, tol: float) -> None:
+    """Every node must lie in the body or within ``tol`` of its boundary."""
+    out = np.flatnonzero(geometry.distance_outside(nodes) > tol)
+    if len(out):
+        first = ", ".join(f"#{i} ({nodes[i, 0]:g}, {nodes[i, 1]:g})" for i in out[:5])
+        raise ProblemError(f"{len(out)} node(s) lie outside the geometry: {first}", key="nodes")
+    from scipy.spatial import cKDTree
+
+    d, _ = cKDTree(nodes).query(nodes, k=2)
+    same = np.flatnonzero(d[:, 1] <= 1e-9 * math.sqrt(geometry.area))
+    if len(same):
+        raise ProblemError(f"{len(same)} node(s) coincide with another, e.g. #{same[0]} "
+                           f"({nodes[same[0], 0]:g}, {nodes[same[0], 1]:g})", key="nodes")
+
+
+def mean_node_spacing(area: float, n_nodes: int) -> float:
+    """d_c = sqrt(A) / sqrt(n - 1), Eq. (36)."""
+    if n_nodes < 2:
+        raise ProblemError(f"{n_nodes} node(s): need at least two to define a node spacing", key="nodes")
+    return math.sqrt(area) / math.sqrt(n_nodes - 1)

@@ -1,0 +1,87 @@
+"""Dynamic relaxation: explicit central differences with local damping (Section 2.1.4, Eqs. 9-11).
+
+    M dv/dt = F_ext - F_int(U) + F_damp,      F_damp = -f |F_ext - F_int| sign(v)          (Eq. 11)
+
+integrated with the half-step velocity, v_{n+1/2} = v_{n-1/2} + dt M^-1 F_n, U_{n+1} = U_n + dt v_{n+1/2},
+the stress updated at every step by the return mapping of that step's strain increment (so the path is
+a pseudo-time path, as in FLAC). For a static answer the mass is fictitious: with dt = 1 each node gets
+m = SAFETY x sum_j |K_ij| over the rows of its two dofs in the elastic stiffness (Gershgorin, Underwood
+1983), which bounds omega_max dt by 2 / sqrt(2 SAFETY) < 2, so the scheme is stable whatever the cloud.
+The run is **at rest** when |F_ext - F_int| <= tolerance |F_ext|; a run still moving after ``steps``
+steps has **not come to rest**: the paper's failure criterion for the slope (its displacement grows
+without bound, Fig. 19a).
+
+True explicit dynamics (density mass, real time step, no damping) is issue 7's; this module serves the
+stability problems of the paper (slope and footing), where the paper uses dynamic relaxation.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ctmrpim.errors import ProblemError
+from ctmrpim.materials.mohr_coulomb import MohrCoulomb
+from ctmrpim.problem.settings import Relaxation
+
+#: Fictitious mass per node = SAFETY x the largest absolute row sum of its dofs' elastic stiffness rows.
+SAFETY = 1.0
+
+
+@dataclass
+class RelaxationPath:
+    at_rest: bool
+    steps: int
+    residual: float                                   # |F_ext - F_int| / |F_ext| at the end
+    history: list[dict] = field(default_factory=list)   # step, max_displacement, residual
+
+    def growth(self) -> float:
+        """Relative growth of the maximum displacement over the last quarter of the steps run."""
+        if not self.history:
+            return 0.0
+        mark = next(h for h in self.history if h["step"] >= 0.75 * self.steps)
+        end = self.history[-1]["max_displacement"]
+        return (end - mark["max_displacement"]) / max(mark["max_displacement"], 1e-300)
+
+
+def max_displacement(U: np.ndarray) -> float:
+    """The largest nodal displacement of interleaved dofs U."""
+    return float(np.linalg.norm(U.reshape(-1, 2), axis=1).max())
+
+
+def relaxation_mass(system) -> np.ndarray:
+    """Per dof: the fictitious nodal mass (equal for a node's two dofs)."""
+    K = abs(system.elastic_stiffness())
+    rows = np.asarray(K.sum(axis=1)).ravel()          # dofs are interleaved (x, y) per node
+    return SAFETY * np.repeat(rows.reshape(-1, 2).max(axis=1), 2)
+
+
+def relax(system, material: MohrCoulomb, load_factor: float, settings: Relaxation,
+          fixed_values: np.ndarray | None = None) -> RelaxationPath:
+    """Relax the system from its committed state under the loads at ``load_factor`` with ``material``;
+    the state is committed at every step. Prescribed displacements are set at once (to
+    ``load_factor`` times their values unless ``fixed_values`` is given)."""
+    mass = relaxation_mass(system)
+    f_ext = system.external_force(load_factor)
+    scale = max(float(np.linalg.norm(f_ext)), 1e-30)
+    U = system.U.copy()
+    U[system.fixed] = load_factor * system.fixed_values if fixed_values is None else fixed_values
+    v = np.zeros_like(U)
+    history: list[dict] = []
+    ratio = np.inf
+    for step in range(1, settings.steps + 1):
+        system.commit(material, U)
+        r = f_ext - system.internal_force()
+        r[system.fixed] = 0.0
+        ratio = float(np.linalg.norm(r)) / scale
+        if not np.isfinite(ratio):
+            raise ProblemError(f"dynamic relaxation diverged at step {step} (non-finite forces)")
+        at_rest = ratio <= settings.tolerance
+        if step % settings.record_every == 0 or at_rest or step == settings.steps:
+            history.append({"step": step, "max_displacement": max_displacement(U), "residual": ratio})
+        if at_rest:
+            return RelaxationPath(True, step, ratio, history)
+        v += (r - settings.damping * np.abs(r) * np.sign(v)) / mass
+        v[system.fixed] = 0.0
+        U = U + v
+    return RelaxationPath(False, settings.steps, ratio, history)

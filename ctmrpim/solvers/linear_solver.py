@@ -1,0 +1,75 @@
+"""Linear static solve K U = F (Eq. 4) with constraints imposed directly on nodal values.
+
+RPIM shape functions have the Kronecker delta property, so a prescribed displacement is the nodal
+value itself: the constrained dofs are eliminated and their values moved to the right-hand side.
+
+Solvers (``method.solver``):
+
+* ``superlu``: SuperLU with the MMD_AT_PLUS_A ordering; measured in DESIGN.md it is 4-6 times faster
+  than scipy's default COLAMD ordering on these stiffness matrices.
+* ``banded``: reverse Cuthill-McKee ordering, then LAPACK's banded Cholesky (K is symmetric positive
+  definite once constrained). On elongated bodies such as the cantilever the band is narrow and this
+  wins: 0.48 s against 0.76 s for SuperLU at 129 x 33 nodes, measured here.
+* ``auto`` (default): ``banded`` when the band is at most BANDED_MAX_FRACTION of the dofs, else
+  ``superlu``; a banded factorisation that finds K indefinite falls back to SuperLU, which then
+  reports the singular matrix.
+* ``spsolve``: scipy's default, for comparison.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+from ctmrpim.errors import ProblemError
+
+BANDED_MAX_FRACTION = 0.1   # auto: banded Cholesky when the RCM half-bandwidth is at most this share of the dofs
+
+
+def solve_constrained(K: sp.csr_matrix, F: np.ndarray, fixed: np.ndarray, values: np.ndarray,
+                      solver: str = "superlu") -> np.ndarray:
+    """U with U[fixed] = values and (K U - F)[free] = 0."""
+    n = K.shape[0]
+    U = np.zeros(n)
+    U[fixed] = values
+    free = np.setdiff1d(np.arange(n), fixed)
+    Kfree = K[free]
+    Kff = Kfree[:, free].tocsr()
+    rhs = F[free] - Kfree[:, fixed] @ values
+    if solver == "spsolve":
+        U[free] = spla.spsolve(Kff.tocsc(), rhs)
+    elif solver in ("auto", "banded") and (x := _banded_cholesky(Kff, rhs, solver == "banded")) is not None:
+        U[free] = x
+    else:
+        try:
+            lu = spla.splu(Kff.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                           options={"SymmetricMode": True})
+        except RuntimeError as exc:  # "Factor is exactly singular"
+            raise ProblemError(f"the stiffness matrix is singular ({exc}): the constraints do not prevent "
+                               "rigid-body motion, or part of the body is detached") from None
+        U[free] = lu.solve(rhs)
+    if not np.all(np.isfinite(U)):
+        raise ProblemError("the linear solve produced non-finite displacements: the stiffness matrix is singular")
+    return U
+
+
+def _banded_cholesky(A: sp.csr_matrix, b: np.ndarray, always: bool) -> np.ndarray | None:
+    """Solve with RCM + banded Cholesky; None when the band is too wide (auto) or A is not positive definite."""
+    perm = reverse_cuthill_mckee(A, symmetric_mode=True)
+    Ap = A[perm][:, perm].tocoo()
+    lower = Ap.row >= Ap.col
+    offset = Ap.row[lower] - Ap.col[lower]
+    bw = int(offset.max()) if len(offset) else 0
+    if not always and bw > BANDED_MAX_FRACTION * A.shape[0]:
+        return None
+    ab = np.zeros((bw + 1, A.shape[0]))
+    ab[offset, Ap.col[lower]] = Ap.data[lower]
+    try:
+        xp = sla.solveh_banded(ab, b[perm], lower=True, check_finite=False)
+    except np.linalg.LinAlgError:
+        return None
+    x = np.empty_like(xp)
+    x[perm] = xp
+    return x

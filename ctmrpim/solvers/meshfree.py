@@ -1,0 +1,46 @@
+"""The CTM-RPIM method (``"ctm-rpim"`` in :mod:`ctmrpim.methods`): each analysis to its solver.
+
+| analysis | material | solver |
+|---|---|---|
+| ``linear`` | linear elastic | :mod:`ctmrpim.solvers.linear_static` (Eqs. 4-6) |
+| ``quasi-static`` | neo-Hookean, linear elastic (rate form) | :mod:`ctmrpim.solvers.updated_lagrangian` (the paper's adaptive method), or :mod:`ctmrpim.solvers.total_lagrangian` |
+| ``quasi-static`` | Mohr-Coulomb (small strain) | :mod:`ctmrpim.solvers.elastoplastic` |
+| ``strength-reduction``, ``dynamic`` | Mohr-Coulomb | :mod:`ctmrpim.solvers.elastoplastic` (Eqs. 38-39, Eq. 11) |
+| ``explicit`` | Mohr-Coulomb | :mod:`ctmrpim.solvers.explicit` (Eqs. 8-11) |
+"""
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+from ctmrpim.materials.mohr_coulomb import MohrCoulomb
+from ctmrpim.methods import RunOptions, register
+from ctmrpim.problem.case import Case
+from ctmrpim.result import Result
+
+
+def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Result:
+    """Solve ``case`` with CTM-RPIM (``element`` is always None: the method has none)."""
+    analysis = case.problem.analysis
+    if analysis == "explicit":
+        from ctmrpim.solvers.explicit.run import solve_explicit
+        if options.out is None:
+            with tempfile.TemporaryDirectory() as tmp:
+                return solve_explicit(case, Path(tmp), options.resume, options.progress_bar)
+        return solve_explicit(case, options.out, options.resume, options.progress_bar)
+    if analysis in ("strength-reduction", "dynamic") or (analysis == "quasi-static"
+                                                         and isinstance(case.problem.material, MohrCoulomb)):
+        from ctmrpim.solvers.elastoplastic import solve_elastoplastic   # small strain: never re-tracked
+        return solve_elastoplastic(case, options.progress)
+    if analysis == "quasi-static":
+        if case.method.formulation == "updated-lagrangian":
+            from ctmrpim.solvers.updated_lagrangian import solve_updated_lagrangian
+            return solve_updated_lagrangian(case)
+        from ctmrpim.solvers.total_lagrangian import solve_total_lagrangian
+        return solve_total_lagrangian(case)
+    from ctmrpim.solvers.linear_static import solve_ctmrpim
+    return solve_ctmrpim(case)
+
+
+register("ctm-rpim", solve_meshfree, description="adaptive CTM-RPIM (CTM integration, RPIM shape functions, "
+                                                  "alpha-shape boundary)")

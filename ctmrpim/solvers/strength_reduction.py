@@ -1,0 +1,232 @@
+"""Strength reduction (Section 3.3.1, Eqs. 38-39): the factor of safety of a body under gravity.
+
+The strengths are divided by the strength reduction factor SRF,
+
+    c' = c / SRF,       tan(phi') = tan(phi) / SRF,       tan(psi') = tan(psi) / SRF,
+
+(the paper reduces c and phi; psi is reduced the same way so that psi' <= phi' stays true, with psi = 0
+it stays 0; a tension cut-off, a strength like c, is divided by SRF too), and the body is equilibrated
+under its full loads, by one of two solvers:
+
+- ``solver = "newton"``: load stepping (:mod:`ctmrpim.load_stepping`); a level is **failed** when Newton
+  cannot reach equilibrium: the SRF sub-step was cut back ``loading.max_cutbacks`` times and still did
+  not converge within ``loading.max_iterations`` iterations;
+- ``solver = "dynamic-relaxation"`` (the paper's, :mod:`ctmrpim.dynamic_relaxation`): the reduction
+  applied at once and relaxed; a level is **failed** when it is still moving after ``dynamic.steps``
+  steps (not at rest, and its maximum displacement grew by more than ``SETTLED_GROWTH`` over the last
+  quarter of the steps: the paper's "the displacement increases continuously").
+
+The criterion is recorded with every level, with the maximum displacement (of the last iterate or
+step at a failed level, where it grows without bound).
+
+Search (``values`` empty): the gravity stage is solved once at SRF = ``start`` (loads ramped by the
+load stepping), then SRF rises by ``step`` from the last stable state, each level continuing from the
+converged state below it (as Kratos GeoMechanics and PLAXIS' Sum-Msf do); after the first failed level
+the interval [stable, failed] is bisected, again from the last stable state, until it is at most
+``width`` wide. The answer is the bracket [stable, failed], not one number.
+
+Sweep (``values = [...]``): each SRF is solved on its own from zero, gravity ramped at the reduced
+strength (Griffiths & Lane 1999); the paper's Fig. 19 plots these. The sweep study sends one case per
+value through the sweep executor so the levels run in parallel.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable
+
+import numpy as np
+
+from ctmrpim.problem.settings import Relaxation, StrengthReduction
+from ctmrpim.solvers.dynamic_relaxation import max_displacement, relax
+from ctmrpim.errors import ProblemError
+from ctmrpim.materials.mohr_coulomb import MohrCoulomb
+from ctmrpim.result import Result
+
+CRITERION = {"newton": "non-convergence: the equilibrium iteration (loading.tangent: Newton, or the elastic "
+                       "stiffness with Anderson mixing) did not reach the residual and displacement tolerance within "
+                       "loading.max_iterations iterations at an SRF sub-step cut back loading.max_cutbacks times",
+             "dynamic-relaxation": "still moving: after dynamic.steps steps of dynamic relaxation the out-of-balance "
+                                   "force is above dynamic.tolerance of the loads and the maximum displacement grew "
+                                   "by more than 1 % over the last quarter of the steps (the paper's criterion: it "
+                                   "keeps growing)"}
+#: Dynamic relaxation: a level not at rest whose maximum displacement grew by at most this fraction over
+#: the last quarter of its steps has settled (a slowly creeping stable level is not a failure).
+SETTLED_GROWTH = 0.01
+
+
+def reduced(material: MohrCoulomb, srf: float) -> MohrCoulomb:
+    """The material with its strength divided by ``srf`` (Eqs. 38-39)."""
+    def angle(a: float) -> float:
+        return math.degrees(math.atan(math.tan(math.radians(a)) / srf))
+    tension = None if material.tension is None else material.tension / srf
+    return replace(material, c=material.c / srf, phi=angle(material.phi), psi=angle(material.psi), tension=tension)
+
+
+@dataclass
+class Level:
+    """One strength-reduction level."""
+
+    srf: float
+    stable: bool
+    iterations: int
+    cutbacks: int
+    seconds: float
+    state: tuple[np.ndarray, ...]    # (U, stress, region, plastic strain): converged, or a failed level's last iterate
+    criterion: str = ""              # a failed level: why; a stable one: how it was reached, where not its own
+    path: list[list[float]] | None = None          # dynamic relaxation: [step, max displacement] as it ran
+
+    @property
+    def max_displacement(self) -> float:
+        return max_displacement(self.state[0])
+
+    def record(self) -> dict[str, Any]:
+        return {"srf": self.srf, "stable": self.stable, "iterations": self.iterations, "cutbacks": self.cutbacks,
+                "max_displacement": self.max_displacement, "seconds": round(self.seconds, 3),
+                **({"criterion": self.criterion} if self.criterion else {}),
+                **({"displacement_history": self.path} if self.path is not None else {})}
+
+
+def _relax_level(system, relaxation: Relaxation, material: MohrCoulomb, srf: float, fixed_values=None) -> Level:
+    """Dynamic relaxation from the committed state with ``material`` under the full loads."""
+    t0 = time.perf_counter()
+    path = relax(system, material, 1.0, relaxation, fixed_values)
+    history = [[h["step"], h["max_displacement"]] for h in path.history]
+    seconds = time.perf_counter() - t0
+    growth = path.growth()
+    if path.at_rest or growth <= SETTLED_GROWTH:
+        note = "" if path.at_rest else (f"not at rest (out-of-balance {path.residual:.1e}) but settled: the "
+                                        f"displacement grew {100 * growth:.2g} % over the last quarter of the steps")
+        return Level(srf, True, path.steps, 0, seconds, system.snapshot(), note, history)
+    return Level(srf, False, path.steps, 0, seconds, system.snapshot(),
+                 f"not at rest, still moving ({100 * growth:.2g} % over the last quarter)", history)
+
+
+def _level(system, loading, material_at, load_at, srf_at: Callable[[float], float], fixed_values=None
+           ) -> tuple[Level, Level | None]:
+    """Run the path t = 0..1 from the committed state; returns the level at t = 1 (stable, or failed
+    at the sub-step that did not converge) and, for a failed level whose cut-back sub-steps got part of
+    the way, the stable level reached (the system is left there)."""
+    t0 = time.perf_counter()
+    path = system.run(loading, material_at, load_at, lambda t, U: {}, fixed_values=fixed_values,
+                      stop_on_failure=True)
+    seconds = time.perf_counter() - t0
+    if path.failed_at is None:
+        return Level(srf_at(1.0), True, path.newton_iterations, path.cutbacks, seconds, system.snapshot()), None
+    failed = Level(srf_at(path.failed_at), False, path.newton_iterations, path.cutbacks, seconds,
+                   system.trial_state(material_at(path.failed_at), path.failed_trial), "non-convergence")
+    reached = [h["load_factor"] for h in path.history if h["converged"]]
+    if not reached:
+        return failed, None
+    return failed, Level(srf_at(reached[-1]), True, 0, 0, 0.0, system.snapshot(),
+                         "reached by the cut-back sub-steps of the next level")
+
+
+def gravity_level(system, loading, material: MohrCoulomb, srf: float, relaxation: Relaxation | None = None) -> Level:
+    """Loads ramped from zero on the reduced material (the first stage of a search; one sweep level);
+    with ``relaxation``, applied at once and relaxed (the paper's way)."""
+    m = reduced(material, srf)
+    if relaxation is not None:
+        return _relax_level(system, relaxation, m, srf)
+    return _level(system, loading, lambda t: m, lambda t: t, lambda t: srf)[0]
+
+
+def search(system, loading, material: MohrCoulomb, settings: StrengthReduction,
+           progress: Callable[[Level], None] = lambda level: None,
+           relaxation: Relaxation | None = None) -> tuple[list[Level], Level, Level]:
+    """Bracket and bisect the factor of safety; returns (levels in order, last stable, first failed
+    of the final bracket). The system is left in the last stable state."""
+    first = gravity_level(system, loading, material, settings.start, relaxation)
+    progress(first)
+    levels = [first]
+    if not first.stable:
+        raise ProblemError(f"the body fails under its loads already at SRF = {settings.start:g} (the gravity "
+                           "stage does not converge); lower strength-reduction.start", key="strength-reduction.start")
+    stable, failed = first, None
+    fixed_values = system.U[system.fixed].copy()
+    level_loading = replace(loading, steps=settings.steps)
+    while failed is None or failed.srf - stable.srf > settings.width * (1 + 1e-9):
+        target = stable.srf + settings.step if failed is None else 0.5 * (stable.srf + failed.srf)
+        if target > settings.max_srf:
+            raise ProblemError(f"no failure up to SRF = {settings.max_srf:g}; raise strength-reduction.max_srf",
+                               key="strength-reduction.max_srf")
+        system.restore(stable.state)
+        s0 = stable.srf
+        srf_at = lambda t, s0=s0, s1=target: s0 + t * (s1 - s0)   # noqa: E731
+        if relaxation is not None:     # the strength reduced at once, relaxed from the stable state
+            level, reached = _relax_level(system, relaxation, reduced(material, target), target, fixed_values), None
+        else:
+            level, reached = _level(system, level_loading, lambda t: reduced(material, srf_at(t)), lambda t: 1.0,
+                                    srf_at, fixed_values)
+        if reached is not None:   # the cut-back sub-steps converged part of the way: stable there
+            progress(reached)
+            levels.append(reached)
+            stable = reached
+        progress(level)
+        levels.append(level)
+        if level.stable:
+            stable = level
+        else:
+            failed = level
+    system.restore(stable.state)
+    return levels, stable, failed
+
+
+def sweep(system, loading, material: MohrCoulomb, values: tuple[float, ...],
+          progress: Callable[[Level], None] = lambda level: None, relaxation: Relaxation | None = None
+          ) -> list[Level]:
+    """Each SRF on its own from zero, gravity at the reduced strength."""
+    start = system.snapshot()
+    levels = []
+    for srf in values:
+        system.restore(start)
+        level = gravity_level(system, loading, material, srf, relaxation)
+        progress(level)
+        levels.append(level)
+    return levels
+
+
+def bracket(levels: list[Level]) -> tuple[float | None, float | None]:
+    """(largest stable SRF below the smallest failed one, smallest failed SRF); None where absent."""
+    failed = min((lv.srf for lv in levels if not lv.stable), default=None)
+    stable = max((lv.srf for lv in levels if lv.stable and (failed is None or lv.srf < failed)), default=None)
+    return stable, failed
+
+
+def solve_strength_reduction(case, system, out, base: Result,
+                             progress: Callable[[Level], None] = lambda level: None) -> Result:
+    """Run the ``[strength-reduction]`` of ``case`` on ``system`` (any discretisation, reported through
+    ``out``, a :class:`ctmrpim.elastoplastic.PlasticOutput`) and fill ``base`` with the last stable
+    state, the levels in the history and the series, and the factor of safety as a bracket."""
+    settings: StrengthReduction = case.strength_reduction
+    material = case.problem.material
+    relaxation = case.relaxation if settings.solver == "dynamic-relaxation" else None
+    t0 = time.perf_counter()
+    if settings.values:
+        levels = sweep(system, case.loading, material, settings.values, progress, relaxation)
+    else:
+        levels, _, _ = search(system, case.loading, material, settings, progress, relaxation)
+    seconds = time.perf_counter() - t0
+    stable, failed = bracket(levels)
+    series = []
+    for lv in levels:
+        U, stress, _, plastic = lv.state
+        series.append({"time": lv.srf, "load_factor": 1.0, "u": out.displacement(U), "stress": out.nodal(stress[:, :3]),
+                       "fields": {**out.plastic_field(plastic), "stable": np.full(len(base.points), float(lv.stable))}})
+    last = next((lv for lv in reversed(levels) if lv.stable and lv.srf == stable), None)
+    if last is not None:
+        U, stress, _, plastic = last.state
+        base.u = out.displacement(U)
+        base.stress = out.nodal(stress[:, :3])
+        base.probes = out.probe_values(U, stress[:, :3])
+        base.fields = out.plastic_field(plastic)
+    base.history = [lv.record() for lv in levels]
+    base.series = series
+    base.outcome = {"factor_of_safety": {"stable": stable, "failed": failed, "criterion": CRITERION[settings.solver],
+                                         "mode": "sweep" if settings.values else "search"}}
+    base.counts.update(levels=len(levels), newton_iterations=sum(lv.iterations for lv in levels),
+                       cutbacks=sum(lv.cutbacks for lv in levels), **system.iteration_counts())
+    base.timings = {**base.timings, "strength_reduction": seconds,
+                    "total": base.timings.get("total", 0.0) + seconds}
+    return base

@@ -1,0 +1,120 @@
+"""Quasi-static total-Lagrangian CTM-RPIM with a hyperelastic material (Section 2.1.3, TL form).
+
+The cross-check of the adaptive updated-Lagrangian path (DESIGN.md): boundary, CTM points, RPIM
+supports and shape functions all live on the reference configuration and are built once. Loads are
+applied in increments (:mod:`ctmrpim.load_stepping`); each increment is solved by Newton-Raphson on
+F_ext - F_int with a residual and a displacement criterion. An increment that does not converge is
+cut in half and retried (and the history says so, never silently), and grows back after easy
+increments. Loads are dead or follower (:mod:`ctmrpim.boundary_loads`).
+
+    F_int[I, i] = sum_p w_p P_iJ(p) dN_I/dX_J(p)
+    K[(I, i), (K, k)] = sum_p w_p dN_I/dX_J A_iJkL dN_K/dX_L        (G^T diag(w A) G, sparse)
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ctmrpim.discretisation import assembly
+from ctmrpim.discretisation.boundary_loads import BoundaryLoads
+from ctmrpim.errors import ProblemError
+from ctmrpim.materials.neo_hookean import NeoHookean
+from ctmrpim.solvers.linear_solver import solve_constrained
+from ctmrpim.solvers.load_stepping import step_loads
+from ctmrpim.discretisation.lagrangian_operators import gradient_operator
+from ctmrpim.solvers.weak_form import internal_force, tangent
+from ctmrpim.timing import Timer
+from ctmrpim.discretisation.configuration import build_configuration
+from ctmrpim.problem.case import Case
+from ctmrpim.result import Result, probe_record
+from ctmrpim.discretisation.rpim import shape_functions
+
+
+def _cauchy(material: NeoHookean, G: sp.csr_matrix, U: np.ndarray) -> np.ndarray:
+    """(m, 3) Cauchy stress sxx, syy, sxy = P F^T / J at the rows of G (stored on the reference points)."""
+    F = np.eye(2)[None] + (G @ U).reshape(-1, 2, 2)
+    P, _ = material.stress_tangent(F)
+    sig = P @ F.transpose(0, 2, 1) / np.linalg.det(F)[:, None, None]
+    return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1]]
+
+
+def solve_total_lagrangian(case: Case) -> Result:
+    """Load-stepped Newton solve of a hyperelastic Case (``case.loading``); ``Result.history`` has one
+    entry per increment (and one per cut-back)."""
+    problem, method = case.problem, case.method
+    material = problem.material
+    if not isinstance(material, NeoHookean):
+        raise ProblemError("the total-Lagrangian solver needs model = \"neo-hookean\"", key="material.model")
+    if problem.plane != "strain":
+        raise ProblemError("the neo-Hookean model is implemented in plane strain; set problem.plane = \"strain\"",
+                           key="problem.plane")
+    if any(problem.body_force):
+        raise ProblemError("gravity is not in the large-deformation solvers yet (a Mohr-Coulomb or linear "
+                           "analysis takes it)", key="problem.gravity")
+    timer = Timer()
+    conf = build_configuration(case, timer)
+    disc, rpim, sf, sf_t = conf.disc, conf.rpim, conf.sf, conf.sf_traction
+    nodes, d_c, quad = disc.nodes, disc.d_c, disc.quadrature
+    fixed, fixed_values, traction_q, tx, ty = conf.fixed, conf.fixed_values, conf.traction, conf.tx, conf.ty
+    probe_xy = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
+    sf_p = shape_functions(nodes, probe_xy, **rpim) if len(probe_xy) else None
+    timer.lap("shape_functions")
+    G = gradient_operator(sf.dNdx, sf.dNdy)
+    GT = G.T
+    w = quad.weights * problem.thickness
+    wt = traction_q.weights * problem.thickness
+    follower = traction_q.follower
+    turn = traction_q.turn_ends
+    loads = BoundaryLoads(sf_t.N, wt, tx, ty, turn, follower, nodes[turn[:, 1]] - nodes[turn[:, 0]],
+                          problem.thickness * assembly.point_load_vector(nodes, problem, rpim))
+
+    timer.lap("assembly")
+
+    n = len(nodes)
+    series: list[dict] = []
+    sf_n = shape_functions(nodes, nodes, **rpim)
+    G_nodes = gradient_operator(sf_n.dNdx, sf_n.dNdy)
+
+    def assemble(U: np.ndarray, factor: float):
+        f_ext, K_load = loads.forces(nodes + U.reshape(-1, 2), factor)
+        P, A = material.stress_tangent(np.eye(2)[None] + (G @ U).reshape(-1, 2, 2))
+        K = tangent(G, A, w, GT)
+        return f_ext, internal_force(G, P, w, GT), (K if K_load is None else K + K_load)
+
+    # follower loads make the tangent non-symmetric: no Cholesky then
+    linear_solver = "superlu" if follower.any() else method.solver
+
+    def solve(K, residual):
+        return solve_constrained(K, residual, fixed, np.zeros(len(fixed)), linear_solver)
+
+    def on_converged(factor: float, U: np.ndarray) -> dict:
+        u = U.reshape(-1, 2)
+        series.append({"load_factor": factor, "u": u.copy(), "stress": _cauchy(material, G_nodes, U)})
+        if sf_p is None:
+            return {}
+        up = sf_p.N @ u
+        return {p.name: {"x": p.x, "y": p.y, "ux": float(up[i, 0]), "uy": float(up[i, 1])}
+                for i, p in enumerate(problem.probes)}
+
+    path = step_loads(2 * n, case.loading, fixed, fixed_values, assemble, solve, on_converged)
+    U, history = path.U, path.history
+    timer.lap("solve")
+
+    u = U.reshape(-1, 2)
+    stress = series[-1]["stress"] if series else _cauchy(material, G_nodes, U)
+    probes = {}
+    if sf_p is not None:
+        up = sf_p.N @ u
+        sig = _cauchy(material, gradient_operator(sf_p.dNdx, sf_p.dNdy), U)
+        probes = {p.name: probe_record(p.x, p.y, up[i], sig[i]) for i, p in enumerate(problem.probes)}
+    timer.lap("postprocess")
+    sizes = sf.support_sizes
+    return Result(
+        method="ctm-rpim-tl", points=nodes, u=u, stress=stress,
+        cells=[("line", disc.boundary.edges)], probes=probes, errors={},
+        counts={"nodes": n, "integration_points": len(w), "load_increments": sum(h["converged"] for h in history),
+                "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
+                "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},
+        timings=timer.total(), history=history, series=series,
+        parameters={**case.resolved, "derived": {"d_c": d_c, "mu": material.mu, "lambda": material.lam}},
+        defaults=case.defaults)

@@ -1,0 +1,372 @@
+"""Adaptive updated-Lagrangian CTM-RPIM, quasi-static (paper Sections 2.1.2-2.1.3, 3.2).
+
+The paper's adaptive method: after every converged load increment the field nodes have moved, and
+the alpha shape re-tracks the boundary on the current node positions, the CTM lines and their
+integration points are laid over the new boundary and the RPIM shape functions are rebuilt there.
+No mesh exists, so none distorts.
+
+Within an increment (nodes at x_n, gradients dN/dx_n and weights w_n of the last rebuild), Newton-
+Raphson solves F_ext - F_int = 0 for the displacement increment du with
+
+    F_int = G_n^T (w_n P_n),   K = G_n^T diag(w_n dP_n/df) G_n + (follower-load stiffness),
+
+P_n = det f sigma f^-T the first Piola-Kirchhoff stress relative to x_n, f = I + d(du)/dx_n. This is
+F_int = sum_p w_{n+1} sigma grad N_{n+1} on x_{n+1} (grad N_{n+1} = grad N_n f^-1, w_{n+1} = w_n det f)
+written without a rebuild. The stress update is objective (:mod:`ctmrpim.objective_stress`: Hughes-
+Winget rotation for the rate form of linear elasticity, the left Cauchy-Green tensor for neo-
+Hookean) and the tangent its exact derivative (complex steps), geometric part included.
+
+Where state lives (DESIGN.md): at the integration points. On a rebuild it is L2-projected onto the
+nodes over the old points and evaluated at the new points (:mod:`ctmrpim.state_transfer`); the
+number of transfers is reported. After the last increment nothing is rebuilt (nothing is solved
+there), and where the alpha shape cannot separate parts that touch (the tip face reaching the root
+at the full end moment) the rebuild is skipped and the history says so: the points then move with
+the body and keep their shape functions, which is exact (it is the total-Lagrangian form relative
+to the last rebuild). Tags are fixed on the reference configuration: constrained dofs,
+loaded boundary segments (node pairs, each Gauss point at its fraction along its segment), probes
+and point loads (material points, carried by the RPIM interpolation of du). Alpha triangles and RPIM
+supports only join nodes that were neighbours in the reference configuration (within 2 alpha and 2
+r_c), so parts of the body that come together (the ends of the rolled-up beam) are not welded. The
+tracked area is compared with the previous configuration's after every rebuild; a jump of more than
+AREA_JUMP means the alpha shape opened or closed a gap, and the solve stops saying so.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from ctmrpim.discretisation import assembly
+from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape
+from ctmrpim.discretisation.boundary_loads import BoundaryLoads
+from ctmrpim.discretisation.ctm import integration_points
+from ctmrpim.errors import ProblemError
+from ctmrpim.materials.neo_hookean import NeoHookean
+from ctmrpim.discretisation.lagrangian_operators import gradient_operator
+from ctmrpim.solvers.weak_form import internal_force, tangent
+from ctmrpim.solvers.linear_solver import solve_constrained
+from ctmrpim.discretisation.configuration import Configuration, build_configuration
+from ctmrpim.timing import Timer
+from ctmrpim.solvers.load_stepping import step_loads
+from ctmrpim.materials.linear_elastic import LinearElastic
+from ctmrpim.materials.objective_stress import HypoelasticUpdate, LeftCauchyGreenUpdate, check_orientation, complex_step_tangent, det2, inv2, largest_strain
+from ctmrpim.problem.case import Case
+from ctmrpim.result import Result, probe_record
+from ctmrpim.discretisation.rpim import shape_functions
+from ctmrpim.discretisation.state_transfer import project_to_nodes, transfer
+
+#: Largest relative change of the tracked area from one configuration to the next (DESIGN.md).
+AREA_JUMP = 0.02
+#: Alpha triangles and RPIM supports join only nodes this many alpha / r_c apart in the reference.
+REFERENCE_NEIGHBOURS = 2.0
+
+
+def stress_update(case: Case):
+    """The objective update of the case's material: neo-Hookean by its left Cauchy-Green tensor,
+    linear elasticity as a Hughes-Winget rate law."""
+    material, problem = case.problem.material, case.problem
+    if isinstance(material, NeoHookean):
+        if problem.plane != "strain":
+            raise ProblemError("the neo-Hookean model is implemented in plane strain; set problem.plane = \"strain\"",
+                               key="problem.plane")
+        return LeftCauchyGreenUpdate(material)
+    if isinstance(material, LinearElastic):
+        return HypoelasticUpdate(problem.D(), problem.plane)
+    raise ProblemError(f"the updated-Lagrangian solver has no stress update for {type(material).__name__}",
+                       key="material.model")
+
+
+@dataclass
+class TractionTags:
+    """Loaded boundary Gauss points as tags: segment node pair, fraction along it, nominal load, and
+    the node pair (reference vector d0) a follower load turns with."""
+
+    ends: np.ndarray
+    fraction: np.ndarray
+    weights: np.ndarray
+    tx: np.ndarray
+    ty: np.ndarray
+    follower: np.ndarray
+    turn_ends: np.ndarray
+    d0: np.ndarray
+
+    def positions(self, x: np.ndarray) -> np.ndarray:
+        a, b = x[self.ends[:, 0]], x[self.ends[:, 1]]
+        return a + self.fraction[:, None] * (b - a)
+
+
+class AdaptiveBody:
+    """The node cloud in its current configuration with everything built on it, and the state at its
+    integration points. ``trial`` evaluates an increment, ``commit`` accepts it and rebuilds."""
+
+    def __init__(self, case: Case, X: np.ndarray, d_c: float, update, traction: TractionTags,
+                 material_points: np.ndarray, point_forces: np.ndarray, timer: Timer):
+        method = case.method
+        self.case, self.X, self.d_c, self.update, self.traction, self.timer = case, X, d_c, update, traction, timer
+        self.x = X.copy()
+        self.U = np.zeros(X.size)                    # total displacement, interleaved
+        self.alpha = method.alpha * d_c
+        self.r_x, self.r_y = (s * d_c for s in method.line_spacing)
+        self.rpim = dict(support_radius=method.support_radius * d_c, eta=method.eta,
+                         polynomial_terms=method.polynomial_terms, scale=d_c)
+        self.far = REFERENCE_NEIGHBOURS * method.support_radius * d_c
+        self.material_X = material_points.copy()   # probes, then point loads
+        self.material_x = material_points.copy()
+        self.point_forces = point_forces
+        self.thickness = case.problem.thickness
+        self.rebuilds = 0
+        self.transfers = 0
+        self.skipped_rebuilds = 0
+        self.areas: list[float] = []
+        self.regeneration = method.point_regeneration
+        self._build()
+        self.state = update.initial(len(self.w))
+        self.nodal_state = update.initial(len(X))
+        self.strained = np.tile(np.eye(2), (len(self.w), 1, 1))   # deformation since the points were laid
+
+    # -- configuration -------------------------------------------------------------------------------
+    def _track(self) -> tuple[Boundary, float]:
+        boundary = alpha_shape(self.x, self.alpha, self.d_c, reference=self.X,
+                               max_reference_edge=REFERENCE_NEIGHBOURS * self.alpha)
+        if len(boundary.detached):
+            i = boundary.detached[0]
+            raise ProblemError(f"{len(boundary.detached)} node(s) left the alpha shape after rebuild {self.rebuilds}, "
+                               f"e.g. #{i} at ({self.x[i, 0]:g}, {self.x[i, 1]:g}); increase method.alpha",
+                               key="method.alpha")
+        area = boundary.area
+        if self.areas and abs(area - self.areas[-1]) > AREA_JUMP * self.areas[-1]:
+            raise ProblemError(
+                f"the tracked area jumped from {self.areas[-1]:.6g} to {area:.6g} ({100 * (area / self.areas[-1] - 1):+.2f} %) "
+                f"at rebuild {self.rebuilds}: the alpha shape opened or closed a gap (now {len(boundary.loops)} "
+                "loop(s)); change method.alpha or use smaller load steps", key="method.alpha")
+        return boundary, area
+
+    def _reference_positions(self, points: np.ndarray, boundary: Boundary) -> np.ndarray:
+        """Reference positions of points inside the body, mapped through their alpha triangle."""
+        tri = boundary.triangles
+        a, b, c = (self.x[tri[:, k]] for k in range(3))
+        # barycentric coordinates in the kept triangles, found with a k-d tree on their centroids
+        centroid = (a + b + c) / 3.0
+        k = min(8, len(tri))
+        _, cand = cKDTree(centroid).query(points, k=k)
+        cand = cand.reshape(len(points), k)
+        A, B, C = a[cand], b[cand], c[cand]
+        v0, v1, v2 = B - A, C - A, points[:, None, :] - A
+        den = v0[..., 0] * v1[..., 1] - v0[..., 1] * v1[..., 0]
+        l1 = (v2[..., 0] * v1[..., 1] - v2[..., 1] * v1[..., 0]) / den
+        l2 = (v0[..., 0] * v2[..., 1] - v0[..., 1] * v2[..., 0]) / den
+        l0 = 1.0 - l1 - l2
+        inside = np.minimum(np.minimum(l0, l1), l2)
+        best = np.argmax(inside, axis=1)
+        rows = np.arange(len(points))
+        t = tri[cand[rows, best]]
+        lam = np.stack([l0[rows, best], l1[rows, best], l2[rows, best]], axis=1)
+        return np.einsum("pk,pkd->pd", lam, self.X[t])
+
+    def _build(self, carried: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> None:
+        """Everything on the current node positions; all or nothing (a failure changes no attribute).
+        New CTM points over the re-tracked boundary, or, with ``carried = (points, weights, reference
+        positions)``, the integration points the body carried through the increment."""
+        boundary, area = self._track()
+        self.timer.lap("boundary")
+        if carried is None:
+            quad = integration_points(boundary.loop_coordinates(), self.r_x, self.r_y,
+                                      self.case.method.gauss_points, mode="uniform")
+            points, w = quad.points, quad.weights * self.thickness
+            ref = self._reference_positions(points, boundary)
+        else:
+            points, w, ref = carried
+        self.timer.lap("integration")
+        tree = cKDTree(self.x)
+        sf = shape_functions(self.x, points, tree=tree, reference=(self.X, ref, self.far), **self.rpim)
+        tr = self.traction
+        Nt = shape_functions(self.x, tr.positions(self.x), derivatives=False, tree=tree,
+                             reference=(self.X, tr.positions(self.X), self.far), **self.rpim).N
+        N_material = shape_functions(self.x, self.material_x, derivatives=False, tree=tree,
+                                     reference=(self.X, self.material_X, self.far), **self.rpim).N
+        n_probe = len(self.material_X) - len(self.point_forces)
+        F_points = assembly.load_vector(N_material[n_probe:], np.full(len(self.point_forces), self.thickness),
+                                        self.point_forces[:, 0], self.point_forces[:, 1]) \
+            if len(self.point_forces) else np.zeros(2 * len(self.x))
+        self.boundary, self.sf, self.N_material = boundary, sf, N_material
+        self.areas.append(area)
+        self.points, self.w, self.points_X = points, w, ref
+        self.G = gradient_operator(sf.dNdx, sf.dNdy)
+        self.GT = self.G.T
+        self.loads = BoundaryLoads(Nt, tr.weights, tr.tx, tr.ty, tr.turn_ends, tr.follower, tr.d0, F_points)
+        self.timer.lap("shape_functions")
+
+    # -- increments ----------------------------------------------------------------------------------
+    def relative_gradient(self, du: np.ndarray) -> np.ndarray:
+        return np.eye(2)[None] + (self.G @ du).reshape(-1, 2, 2)
+
+    def trial(self, U: np.ndarray, factor: float) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix]:
+        """F_ext, F_int and the tangent at the total displacement ``U`` (interleaved)."""
+        du = U - self.U
+        f = self.relative_gradient(du)
+        check_orientation(f)
+        P = self.update.first_piola(f, self.state)
+        A = complex_step_tangent(self.update, f, self.state)
+        f_ext, K_load = self.loads.forces(self.x + du.reshape(-1, 2), factor)
+        K = tangent(self.G, A, self.w, self.GT)
+        return f_ext, internal_force(self.G, P, self.w, self.GT), (K if K_load is None else K + K_load)
+
+    def commit(self, U: np.ndarray, rebuild: bool = True) -> str | None:
+        """Accept the increment: advance the state, move nodes and points, re-track, rebuild.
+
+        The CTM points are laid anew over the re-tracked boundary (and the state transferred to them)
+        every increment, or, with ``method.point_regeneration = s > 0``, only once a point has been
+        strained by more than s since the points were laid; until then the points move with the body
+        and keep their state, and only the boundary and the RPIM shape functions are rebuilt.
+        Without ``rebuild`` (the last increment), or when the re-tracking cannot separate parts of the
+        body that have come into contact (nodes left out of the alpha shape, or an area jump), the
+        points move with the body and keep their shape functions, the gradients mapped to the new
+        configuration (grad N_{n+1} = grad N_n f^-1, w_{n+1} = w_n det f); the reason is returned so
+        the history can say so. ``U`` is the total displacement (interleaved)."""
+        du = U - self.U
+        f = self.relative_gradient(du)
+        state = self.update.advance(f, self.state)
+        d = du.reshape(-1, 2)
+        w_moved = self.w * det2(f)
+        N_old = self.sf.N
+        moved = self.points + N_old @ d
+        strained = f @ self.strained
+        self.U = U.copy()
+        self.x = self.X + U.reshape(-1, 2)       # from the total, so prescribed values come out exact
+        self.material_x = self.material_x + self.N_material @ d
+        self.timer.lap("solve")
+        skipped = None
+        if rebuild:
+            regenerate = self.regeneration == 0.0 or largest_strain(strained) > self.regeneration
+            try:
+                self._build(None if regenerate else (moved, w_moved, self.points_X))
+            except ProblemError as err:
+                skipped = f"rebuild skipped, the previous points carried: {err}"
+            else:
+                self.rebuilds += 1
+                if regenerate:
+                    self.state, self.nodal_state = transfer(N_old, w_moved, state, self.sf.N)
+                    self.strained = np.tile(np.eye(2), (len(self.w), 1, 1))
+                    self.transfers += 1
+                else:
+                    self.state, self.strained = state, strained
+                    self.nodal_state = project_to_nodes(self.sf.N, self.w, state)
+                self.timer.lap("transfer")
+                return None
+        self.points, self.state, self.w, self.strained = moved, state, w_moved, strained
+        self._map_gradients(f)
+        self.nodal_state = project_to_nodes(N_old, w_moved, state)
+        self.skipped_rebuilds += skipped is not None
+        self.timer.lap("transfer")
+        return skipped
+
+    def _map_gradients(self, f: np.ndarray) -> None:
+        finv = inv2(f)
+        dx, dy = self.sf.dNdx, self.sf.dNdy
+        rows = np.repeat(np.arange(dx.shape[0]), np.diff(dx.indptr))
+        data_x = dx.data * finv[rows, 0, 0] + dy.data * finv[rows, 1, 0]
+        data_y = dx.data * finv[rows, 0, 1] + dy.data * finv[rows, 1, 1]
+        self.sf.dNdx = sp.csr_matrix((data_x, dx.indices, dx.indptr), shape=dx.shape)
+        self.sf.dNdy = sp.csr_matrix((data_y, dx.indices, dx.indptr), shape=dx.shape)
+        self.G = gradient_operator(self.sf.dNdx, self.sf.dNdy)
+        self.GT = self.G.T
+
+    @property
+    def u(self) -> np.ndarray:
+        return self.U.reshape(-1, 2).copy()
+
+    def stress_nodes(self) -> np.ndarray:
+        return self.update.cauchy(self.nodal_state)
+
+
+def _traction_tags(conf, thickness: float) -> TractionTags:
+    q = conf.traction
+    nodes = conf.disc.nodes
+    a, b = nodes[q.ends[:, 0]], nodes[q.ends[:, 1]]
+    fraction = np.einsum("pd,pd->p", q.points - a, b - a) / np.einsum("pd,pd->p", b - a, b - a)
+    turn = q.turn_ends
+    return TractionTags(q.ends, fraction, q.weights * thickness, conf.tx, conf.ty, q.follower, turn,
+                        nodes[turn[:, 1]] - nodes[turn[:, 0]])
+
+
+def adaptive_body(case: Case, timer: Timer | None = None) -> tuple[AdaptiveBody, Configuration]:
+    """The case's node cloud as an :class:`AdaptiveBody` in its reference configuration, and the
+    reference configuration's tags (constrained dofs and the rest)."""
+    problem = case.problem
+    update = stress_update(case)
+    if case.method.boundary != "alpha":
+        raise ProblemError("the updated-Lagrangian solver integrates over the tracked boundary; "
+                           "set method.boundary = \"alpha\"", key="method.boundary")
+    timer = timer or Timer()
+    conf = build_configuration(case, timer)      # reference cloud, tags, and the checks of a linear run
+    probes_X = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
+    loads_X = np.array([[p.x, p.y] for p in problem.point_loads]).reshape(-1, 2)
+    forces = np.array([[p.fx, p.fy] for p in problem.point_loads]).reshape(-1, 2)
+    body = AdaptiveBody(case, conf.disc.nodes, conf.disc.d_c, update, _traction_tags(conf, problem.thickness),
+                        np.r_[probes_X, loads_X], forces, timer)
+    return body, conf
+
+
+def solve_updated_lagrangian(case: Case) -> Result:
+    """Adaptive load-stepped Newton solve of a quasi-static Case; ``Result.history`` has one entry per
+    increment (and one per cut-back), ``Result.series`` the configuration after each increment with
+    its tracked boundary."""
+    problem = case.problem
+    if any(problem.body_force):
+        raise ProblemError("gravity is not in the large-deformation solvers yet (a Mohr-Coulomb or linear "
+                           "analysis takes it)", key="problem.gravity")
+    timer = Timer()
+    body, conf = adaptive_body(case, timer)
+    update, X, d_c = body.update, body.X, body.d_c
+    probes_X = body.material_X[:len(problem.probes)]
+    n = len(X)
+    fixed, fixed_values = conf.fixed, conf.fixed_values
+    series: list[dict] = []
+
+    def solve(K, residual):   # the rate-form and follower tangents are not symmetric
+        return solve_constrained(K, residual, fixed, np.zeros(len(fixed)), "superlu")
+
+    def probe_values() -> dict:
+        u = body.material_x[:len(probes_X)] - probes_X
+        return {p.name: {"x": p.x, "y": p.y, "ux": float(u[i, 0]), "uy": float(u[i, 1])}
+                for i, p in enumerate(problem.probes)}
+
+    def on_converged(factor: float, U: np.ndarray) -> dict:
+        # nothing is solved on the final configuration: no rebuild there (at the full end moment the
+        # tip face touches the root face, where no alpha shape separates them)
+        skipped = body.commit(U, rebuild=factor < 1.0 - 1e-12)
+        series.append({"load_factor": factor, "u": body.u.copy(), "stress": body.stress_nodes(),
+                       "boundary": body.boundary.edges.copy()})
+        return {**probe_values(), "tracked_area": body.areas[-1], "boundary_loops": len(body.boundary.loops),
+                **({"note": skipped} if skipped else {})}
+
+    path = step_loads(2 * n, case.loading, fixed, fixed_values, body.trial, solve, on_converged)
+    history = path.history
+
+    probes = {}
+    if len(probes_X):
+        rows = body.N_material[:len(probes_X)]
+        sig = update.cauchy(np.asarray(rows @ body.nodal_state))
+        u = body.material_x[:len(probes_X)] - probes_X
+        probes = {p.name: probe_record(p.x, p.y, u[i], sig[i]) for i, p in enumerate(problem.probes)}
+    timer.lap("postprocess")
+    sizes = body.sf.support_sizes
+    areas = np.array(body.areas)
+    return Result(
+        method="ctm-rpim-ul", points=X, u=body.u, stress=body.stress_nodes(),
+        cells=[("line", body.boundary.edges)], probes=probes, errors={},
+        counts={"nodes": n, "integration_points": len(body.w), "load_increments": sum(h["converged"] for h in history),
+                "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
+                "rebuilds": body.rebuilds, "state_transfers": body.transfers,
+                "rebuilds_skipped": body.skipped_rebuilds,
+                "boundary_loops": len(body.boundary.loops),
+                "tracked_area": {"initial": float(areas[0]), "final": float(areas[-1]),
+                                 "largest_step_change": float(np.abs(np.diff(areas) / areas[:-1]).max())
+                                 if len(areas) > 1 else 0.0},
+                "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},
+        timings=timer.total(), history=history, series=series,
+        parameters={**case.resolved, "derived": {"d_c": d_c, "alpha": body.alpha,
+                                                 "support_radius": body.rpim["support_radius"]}},
+        defaults=case.defaults)

@@ -1,0 +1,42 @@
+"""Wall time per phase of a solve, the one way every solver (and the FE reference) measures it.
+
+``summary.json`` reports ``timings`` as ``{phase: seconds, ..., "total": seconds}``. A solver either
+takes laps (``timer.lap("assembly")`` books the time since the last lap) or measures a block that
+recurs, such as one phase of every Newton iteration (``with timer.measure("tangent"): ...``, summed).
+"""
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+from typing import Iterator
+
+
+class Timer:
+    """Phases of one solve, in seconds (``time.perf_counter``), started at construction."""
+
+    def __init__(self) -> None:
+        self.t0 = self.last = time.perf_counter()
+        self.phases: dict[str, float] = {}
+
+    def add(self, name: str, seconds: float) -> None:
+        """Book ``seconds`` to phase ``name`` (phases sum over repeated bookings)."""
+        self.phases[name] = self.phases.get(name, 0.0) + seconds
+
+    def lap(self, name: str) -> None:
+        """Book the time since the previous lap (or the start) to phase ``name``."""
+        now = time.perf_counter()
+        self.add(name, now - self.last)
+        self.last = now
+
+    @contextmanager
+    def measure(self, name: str) -> Iterator[None]:
+        """Book the time spent inside the ``with`` block to phase ``name`` (laps are not moved)."""
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.add(name, time.perf_counter() - start)
+
+    def total(self) -> dict[str, float]:
+        """The phases and ``total``, the time since the start."""
+        return {**self.phases, "total": time.perf_counter() - self.t0}
