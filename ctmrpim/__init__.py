@@ -11,13 +11,12 @@ Subpackages: :mod:`ctmrpim.problem` (the continuous problem and its input), :mod
 :mod:`ctmrpim.io` and :mod:`ctmrpim.reference` (exact and reference solutions, error norms).
 """
 
-__version__ = "0.1.0"
-
-from ctmrpim.cases import load_case  # noqa: E402
-from ctmrpim.errors import ProblemError  # noqa: E402
-from ctmrpim.methods import register, solve  # noqa: E402
-from ctmrpim.problem.case import Case  # noqa: E402
-from ctmrpim.problem.model import Problem  # noqa: E402
-from ctmrpim.result import Result  # noqa: E402
+from ctmrpim.cases import load_case
+from ctmrpim.errors import ProblemError
+from ctmrpim.methods import register, solve
+from ctmrpim.problem.case import Case
+from ctmrpim.problem.model import Problem
+from ctmrpim.result import Result
+from ctmrpim.version import __version__
 
 __all__ = ["Case", "Problem", "ProblemError", "Result", "__version__", "load_case", "register", "solve"]

@@ -1,7 +1,7 @@
 """The methods that solve a :class:`~ctmrpim.problem.case.Case`, found by name.
 
 Every method registers a solve function here with :func:`register`: CTM-RPIM (``"ctm-rpim"``,
-:mod:`ctmrpim.solvers.meshfree`) and any finite-element reference, which lives in its own package and
+:func:`ctmrpim.solvers.meshfree.solve_meshfree`, registered on first use) and any finite-element reference, which lives in its own package and
 is announced by an entry point of the group ``ctmrpim.methods`` in its distribution's metadata (the
 scikit-fem reference: ``fem = "reference_fem.method"``). Loading the entry point imports the module,
 which registers itself; the core never imports a reference, so a reference can import the core freely.
@@ -9,7 +9,7 @@ which registers itself; the core never imports a reference, so a reference can i
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any, Callable
@@ -17,21 +17,12 @@ from typing import Any, Callable
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result
+from ctmrpim.run_options import RunOptions
 
 #: entry-point group of methods that live in other packages
 GROUP = "ctmrpim.methods"
 #: the method this package implements
 DEFAULT = "ctm-rpim"
-
-
-@dataclass(frozen=True)
-class RunOptions:
-    """How a solve reports and where it writes as it goes (explicit dynamics: series and checkpoints)."""
-
-    progress: Callable[[Any], None] = field(default=lambda level: None)   # each strength-reduction level
-    out: Path | None = None          # folder for a long run's series and checkpoints (a temporary one if None)
-    resume: bool = False             # continue from the checkpoint in ``out``
-    progress_bar: bool = False
 
 
 @dataclass(frozen=True)
@@ -63,7 +54,9 @@ def get(name: str) -> SolutionMethod:
     """The method called ``name``, imported on first use; a ProblemError for an unknown name."""
     if name not in _REGISTRY:
         if name == DEFAULT:
-            from ctmrpim.solvers import meshfree  # noqa: F401  (registers "ctm-rpim")
+            from ctmrpim.solvers.meshfree import solve_meshfree
+            register(DEFAULT, solve_meshfree, description="adaptive CTM-RPIM (CTM integration, RPIM shape "
+                                                          "functions, alpha-shape boundary)")
         else:
             for ep in entry_points(group=GROUP, name=name):
                 ep.load()

@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 
 from ctmrpim import benchmarks
-from ctmrpim.reference import elastica
 from ctmrpim.methods import solve
+from ctmrpim.reference import elastica
 from studies.tip_load import MIN_STEPS
 
 L = 10.0

@@ -20,16 +20,15 @@ from scipy.sparse import csc_matrix
 from scipy.sparse.linalg import splu
 from skfem import Basis, BilinearForm, ElementQuad1, ElementTriP1, ElementVector, FacetBasis, LinearForm
 
-from ctmrpim.solvers.plastic_system import PlasticOutput, PlasticSystem, run_elastoplastic
 from ctmrpim.errors import ProblemError
-from ctmrpim.timing import Timer
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result, probe_record
+from ctmrpim.solvers.plastic_system import PlasticOutput, PlasticSystem, run_elastoplastic
+from ctmrpim.timing import Timer
 
 from .mesh import build_mesh
-from .solve import (FACET_ORDER, SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate, _selected_facets,
-                    _value)
+from .solve import FACET_ORDER, SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate, _selected_facets, _value
 
 #: The linear element on the same cells: its hat functions average point values onto the vertices.
 LINEAR_ELEMENTS = {"q1": ElementQuad1, "p1": ElementTriP1, "p2": ElementTriP1}

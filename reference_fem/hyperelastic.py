@@ -24,13 +24,21 @@ from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, co
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.neo_hookean import NeoHookean
-from ctmrpim.solvers.load_stepping import step_loads
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result, probe_record
+from ctmrpim.solvers.load_stepping import step_loads
 
 from .mesh import FemMesh, build_mesh
-from .solve import (FACET_ORDER, SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate, _selected_facets,
-                    _traction_form, _value)
+from .solve import (
+    FACET_ORDER,
+    SCALAR_ELEMENTS,
+    _constrained_dofs,
+    _load_vector,
+    _locate,
+    _selected_facets,
+    _traction_form,
+    _value,
+)
 
 #: Quadrature degree of f_int and K (P, A are not polynomial: one order above the linear need for P2).
 TANGENT_ORDER = {"q1": 2, "p1": 1, "p2": 4}

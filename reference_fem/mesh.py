@@ -16,9 +16,8 @@ from skfem import MeshQuad, MeshTri
 from skfem.mesh import Mesh
 
 from ctmrpim.errors import ProblemError
-from ctmrpim.problem.node_cloud import mean_node_spacing
-from ctmrpim.problem.node_cloud import make_nodes
 from ctmrpim.problem.case import Case
+from ctmrpim.problem.node_cloud import make_nodes, mean_node_spacing
 
 ELEMENTS = ("q1", "p1", "p2")
 #: Triangles smaller than this fraction of d_c**2 are slivers of collinear points and are dropped.

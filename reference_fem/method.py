@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
-from ctmrpim.methods import RunOptions, register
+from ctmrpim.methods import register
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result
+from ctmrpim.run_options import RunOptions
 
 #: element types, the first the default (bilinear quadrilaterals on a grid, else linear triangles)
 ELEMENTS = ("q1", "p1", "p2")

@@ -12,16 +12,26 @@ from typing import Callable
 import numpy as np
 from scipy.sparse import csc_matrix
 from scipy.sparse.linalg import splu
-from skfem import (Basis, BilinearForm, ElementQuad1, ElementTriP1, ElementTriP2, ElementVector, FacetBasis,
-                   LinearForm, condense, solve)
+from skfem import (
+    Basis,
+    BilinearForm,
+    ElementQuad1,
+    ElementTriP1,
+    ElementTriP2,
+    ElementVector,
+    FacetBasis,
+    LinearForm,
+    condense,
+    solve,
+)
 from skfem.assembly.basis import AbstractBasis
 from skfem.mesh import Mesh
 
-from ctmrpim.reference.error_norms import relative_errors
 from ctmrpim.errors import ProblemError
+from ctmrpim.problem.case import Case
 from ctmrpim.problem.expressions import Field
 from ctmrpim.problem.model import Problem
-from ctmrpim.problem.case import Case
+from ctmrpim.reference.error_norms import relative_errors
 from ctmrpim.result import Result, probe_errors, probe_record
 
 from .mesh import FemMesh, build_mesh

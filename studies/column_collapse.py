@@ -24,8 +24,8 @@ import numpy as np
 import pandas as pd
 
 from ctmrpim import benchmarks
-from ctmrpim.reference.deposit import curve_distance, failure_line, run_out, slope_angle, surface_profile
 from ctmrpim.io.vtu import read_pvd
+from ctmrpim.reference.deposit import curve_distance, failure_line, run_out, slope_angle, surface_profile
 from studies.sweep import CaseSpec
 
 NAME = "column_collapse"

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from ctmrpim import benchmarks
-from ctmrpim.reference import elastica
 from ctmrpim.methods import solve
+from ctmrpim.reference import elastica
 
 from .base import finished, new_figure, save_figure
 

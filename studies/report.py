@@ -14,13 +14,11 @@ import numpy as np
 import pandas as pd
 
 import studies
-from studies import claims
-from studies.fitting import fitted_rate
-from studies.time_to_accuracy import targets_table
-
-from studies import tolerances
 from ctmrpim.io.atomic import atomic_write_text
+from studies import claims, tolerances
+from studies.fitting import fitted_rate
 from studies.sweep import Sweep
+from studies.time_to_accuracy import targets_table
 
 RATE_GRIDS = ["17 x 5", "33 x 9", "65 x 17"]
 

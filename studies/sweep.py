@@ -15,10 +15,12 @@ from __future__ import annotations
 
 import hashlib
 import json
+import sys
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
+from functools import cache
 from multiprocessing import get_all_start_methods, get_context
 from pathlib import Path
 from typing import Any, Iterable
@@ -26,7 +28,7 @@ from typing import Any, Iterable
 from ctmrpim.cases import load_case
 from ctmrpim.errors import ProblemError
 from ctmrpim.io.atomic import atomic_write_text
-from ctmrpim.io.provenance import method_version
+from ctmrpim.io.provenance import code_version, source_hash
 from ctmrpim.io.summary import to_jsonable, write_summary
 from ctmrpim.methods import solve
 
@@ -48,6 +50,19 @@ class CaseSpec:
 def element_of(solver: str, element: str) -> str | None:
     """``element`` for a finite-element method, None for CTM-RPIM (which has no elements)."""
     return None if solver == "ctm-rpim" else element
+
+
+@cache
+def method_version(name: str) -> str:
+    """The version of the code behind the method ``name``: this package's (:func:`code_version`), plus
+    the source hash of the package that registered the method where that is another one (the
+    finite-element reference)."""
+    from ctmrpim.methods import get
+
+    package = get(name).solve.__module__.split(".")[0]
+    if package == "ctmrpim":
+        return code_version()
+    return f"{code_version()}+{package}-{source_hash(Path(sys.modules[package].__file__).parent)[:16]}"
 
 
 def case_hash(spec: CaseSpec) -> str:
@@ -195,7 +210,8 @@ class Sweep:
 
     def _execute_dask(self, jobs: list[tuple[CaseSpec, str, str]], bar) -> None:
         try:
-            from dask.distributed import Client, as_completed as dask_completed
+            from dask.distributed import Client
+            from dask.distributed import as_completed as dask_completed
         except ImportError:
             raise ProblemError("--scheduler needs dask.distributed: pip install 'ctmrpim[dask]'") from None
         try:

@@ -5,8 +5,7 @@ import numpy as np
 import shapely
 
 from ctmrpim.problem.geometry import Geometry, Shape
-from ctmrpim.problem.node_cloud import mean_node_spacing
-from ctmrpim.problem.node_cloud import NodeSpec, make_nodes
+from ctmrpim.problem.node_cloud import NodeSpec, make_nodes, mean_node_spacing
 
 GEOMETRIES = {
     "rectangle": Geometry([Shape("rectangle", (0.0, 0.0, 4.0, 1.0))]),

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from clouds import GEOMETRIES, HOLES, cloud
+
 from ctmrpim.discretisation.alpha_shape import _loops, alpha_shape, signed_area
 from ctmrpim.errors import ProblemError
 from studies.tolerances import entry

@@ -6,8 +6,8 @@ import pytest
 from verify import check, check_rate
 
 from ctmrpim import benchmarks
-from ctmrpim.solvers.linear_static import solve_ctmrpim
 from ctmrpim.result import Result
+from ctmrpim.solvers.linear_static import solve_ctmrpim
 
 GRIDS = ((17, 5), (33, 9), (65, 17))
 

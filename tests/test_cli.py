@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from ctmrpim import benchmarks
-from studies import tolerances
-from ctmrpim.solvers.linear_static import solve_ctmrpim
 from ctmrpim.result import Result
+from ctmrpim.solvers.linear_static import solve_ctmrpim
+from studies import tolerances
 
 SCRIPT = Path(sys.executable).with_name("ctmrpim")   # the console script of the environment under test
 

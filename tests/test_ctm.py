@@ -4,9 +4,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
+from clouds import GEOMETRIES
 from shapely.geometry import Polygon
 
-from clouds import GEOMETRIES
 from ctmrpim.discretisation.ctm import boundary_points, integration_points
 from studies.tolerances import entry
 

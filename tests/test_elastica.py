@@ -14,7 +14,14 @@ from scipy.special import ellipe, ellipeinc, ellipk, ellipkinc
 from verify import check
 
 from ctmrpim.reference import elastica
-from ctmrpim.reference.elastica import PAPER_LOADS_KN, end_moment_tip, paper_lambda, ring_moment, tip_load_bvp, tip_load_elliptic
+from ctmrpim.reference.elastica import (
+    PAPER_LOADS_KN,
+    end_moment_tip,
+    paper_lambda,
+    ring_moment,
+    tip_load_bvp,
+    tip_load_elliptic,
+)
 
 AGREEMENT_LAMBDAS = (0.12, 0.5, 1.0, 2.0, 3.0, 3.6)
 PAPER_LAMBDAS = tuple(paper_lambda(p) for p in PAPER_LOADS_KN)

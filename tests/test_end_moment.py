@@ -7,9 +7,9 @@ import pytest
 from verify import check
 
 from ctmrpim import benchmarks
-from ctmrpim.reference import elastica
 from ctmrpim.errors import ProblemError
 from ctmrpim.methods import solve
+from ctmrpim.reference import elastica
 
 L = 10.0
 
@@ -31,8 +31,8 @@ def test_face_follower_tractions_stay_a_couple() -> None:
     """follower = "face": both half-face tractions turn with the chord of the whole end face, so at
     any displacement their nodal forces sum to zero (a pure couple) and turn rigidly."""
     from ctmrpim.discretisation.boundary_loads import BoundaryLoads
-    from ctmrpim.timing import Timer
     from ctmrpim.discretisation.configuration import build_configuration
+    from ctmrpim.timing import Timer
 
     case = benchmarks.load("end-moment", ["parameters.m=0.25"])
     conf = build_configuration(case, Timer())

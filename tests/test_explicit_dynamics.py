@@ -15,14 +15,25 @@ import numpy as np
 import pytest
 
 from ctmrpim import benchmarks
-from ctmrpim.errors import ProblemError
-from ctmrpim.solvers.explicit.run import ExplicitRun, input_key, solve_explicit
-from ctmrpim.materials.mohr_coulomb_kernel import point_update
 from ctmrpim.discretisation.lumped_mass import lumped_mass
+from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, MohrCoulomb, plastic_strain_increment
-from ctmrpim.materials.objective_stress import det2, det_c, first_piola_c, hughes_winget, hughes_winget_c, inv2, largest_strain, largest_strain_c, relative_c, rotate_c
+from ctmrpim.materials.mohr_coulomb_kernel import point_update
+from ctmrpim.materials.objective_stress import (
+    det2,
+    det_c,
+    first_piola_c,
+    hughes_winget,
+    hughes_winget_c,
+    inv2,
+    largest_strain,
+    largest_strain_c,
+    relative_c,
+    rotate_c,
+)
 from ctmrpim.problem.model import Wall
 from ctmrpim.solvers.explicit.contact import enforce_walls
+from ctmrpim.solvers.explicit.run import ExplicitRun, input_key, solve_explicit
 
 QUICK = ["nodes.grid=[16, 9]", "method.alpha=2.0"]
 
@@ -140,8 +151,8 @@ def test_critical_time_step_bounds_the_wave_speed_step():
     run = ExplicitRun(case, Path("unused"), "key")
     run.start()
     assert 0.2 * run.dt_wave < run.dt < 2.0 * run.dt_wave
-    from scipy.sparse.linalg import eigsh
     import scipy.sparse as sp
+    from scipy.sparse.linalg import eigsh
     n = len(run.X)
     K = np.column_stack([run._stiffness(run.frame)(e.reshape(n, 2)).ravel() for e in np.eye(2 * n)])
     m = np.repeat(run.mass, 2)

@@ -6,11 +6,11 @@ import pytest
 from verify import check, check_rate
 
 from ctmrpim import benchmarks
-from studies import tolerances
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.node_cloud import make_nodes
 from ctmrpim.result import Result
 from reference_fem import solve_fem
+from studies import tolerances
 
 GRIDS = ((17, 5), (33, 9), (65, 17))
 L = 48.0

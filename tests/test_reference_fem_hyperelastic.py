@@ -7,9 +7,9 @@ import pytest
 from verify import check
 
 from ctmrpim import benchmarks
-from ctmrpim.reference import elastica
 from ctmrpim.errors import ProblemError
 from ctmrpim.methods import solve
+from ctmrpim.reference import elastica
 from reference_fem.hyperelastic import solve_fem_hyperelastic
 
 L = 10.0

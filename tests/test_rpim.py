@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from clouds import cloud
 from scipy.interpolate import RBFInterpolator
 
-from clouds import cloud
-from ctmrpim.errors import ProblemError
 from ctmrpim.discretisation.rpim import shape_functions
+from ctmrpim.errors import ProblemError
 from studies.tolerances import entry
 
 ROUNDOFF = entry("roundoff")["max"]

@@ -12,14 +12,14 @@ from scipy.sparse.linalg import spsolve
 from verify import check
 
 from ctmrpim import benchmarks
-from ctmrpim.solvers.plastic_system import block_rows
-from ctmrpim.solvers.elastoplastic import ctm_plastic_system
 from ctmrpim.errors import ProblemError
-from ctmrpim.timing import Timer
-from ctmrpim.solvers.load_stepping import Anderson
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
 from ctmrpim.methods import solve
+from ctmrpim.solvers.elastoplastic import ctm_plastic_system
+from ctmrpim.solvers.load_stepping import Anderson
+from ctmrpim.solvers.plastic_system import block_rows
 from ctmrpim.solvers.strength_reduction import bracket, reduced
+from ctmrpim.timing import Timer
 
 BISHOP = {"slope": 1.368, "slope-gl": 1.378}
 PRANDTL = (2.0 + math.pi) * 100e3

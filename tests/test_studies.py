@@ -6,8 +6,8 @@ import pytest
 from verify import check
 
 import studies
-from studies.sweep import Sweep
 from studies import claims
+from studies.sweep import Sweep
 
 
 @pytest.fixture(scope="module")

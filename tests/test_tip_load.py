@@ -6,9 +6,9 @@ import pytest
 from verify import check
 
 from ctmrpim import benchmarks
-from ctmrpim.reference import elastica
 from ctmrpim.errors import ProblemError
 from ctmrpim.methods import solve
+from ctmrpim.reference import elastica
 
 L = 10.0
 TL = 'method.formulation="total-lagrangian"'

@@ -7,9 +7,14 @@ import numpy as np
 import pytest
 
 from ctmrpim.cases import load_case
-from ctmrpim.materials.neo_hookean import NeoHookean
-from ctmrpim.materials.objective_stress import LeftCauchyGreenUpdate, HypoelasticUpdate, complex_step_tangent, hughes_winget
 from ctmrpim.discretisation.state_transfer import project_to_nodes, transfer
+from ctmrpim.materials.neo_hookean import NeoHookean
+from ctmrpim.materials.objective_stress import (
+    HypoelasticUpdate,
+    LeftCauchyGreenUpdate,
+    complex_step_tangent,
+    hughes_winget,
+)
 from ctmrpim.solvers.updated_lagrangian import adaptive_body
 
 E = 1.0e9
@@ -137,8 +142,8 @@ def test_tip_load_updated_lagrangian_against_the_elastica() -> None:
     from verify import check
 
     from ctmrpim import benchmarks
-    from ctmrpim.reference import elastica
     from ctmrpim.methods import solve
+    from ctmrpim.reference import elastica
 
     r = solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=6", UL]))
     exact = elastica.tip_load_elliptic(1.2)
@@ -155,8 +160,8 @@ def test_end_moment_quarter_updated_lagrangian() -> None:
     from verify import check
 
     from ctmrpim import benchmarks
-    from ctmrpim.reference import elastica
     from ctmrpim.methods import solve
+    from ctmrpim.reference import elastica
 
     r = solve(benchmarks.load("end-moment", ["parameters.m=0.25", "loading.steps=16", UL]))
     x, y = 1.0 + r.probes["tip"]["ux"] / L, r.probes["tip"]["uy"] / L
@@ -171,8 +176,8 @@ def test_corner_point_load_updated_lagrangian() -> None:
     from verify import check
 
     from ctmrpim import benchmarks
-    from ctmrpim.reference import elastica
     from ctmrpim.methods import solve
+    from ctmrpim.reference import elastica
 
     r = solve(benchmarks.load("tip-load-corner", ["parameters.lam=1.8", "loading.steps=8", UL]))
     w = -r.probes["tip"]["uy"] / L
@@ -205,8 +210,8 @@ def test_carried_points_keep_their_state() -> None:
     from verify import check
 
     from ctmrpim import benchmarks
-    from ctmrpim.reference import elastica
     from ctmrpim.methods import solve
+    from ctmrpim.reference import elastica
 
     r = solve(benchmarks.load("end-moment", ["parameters.m=0.25", "loading.steps=16", UL,
                                              "method.point_regeneration=0.5"]))

@@ -8,11 +8,10 @@ results and is left out, and the application above the package (sweeps, studies,
 from __future__ import annotations
 
 import hashlib
-import sys
 from functools import cache
 from pathlib import Path
 
-from ctmrpim import __version__
+from ctmrpim.version import __version__
 
 #: files of this package that present results but never compute them
 PRESENTATION = ("cli.py",)
@@ -40,16 +39,3 @@ def source_hash(package: Path, exclude: tuple[str, ...] = ()) -> str:
 def code_version() -> str:
     """``VERSION+HASH`` of this package's result-computing sources."""
     return f"{__version__}+{source_hash(PACKAGE, PRESENTATION)[:16]}"
-
-
-@cache
-def method_version(name: str) -> str:
-    """The code version behind the method ``name`` of :mod:`ctmrpim.methods`: this package's, plus the
-    hash of the package that registered it where that is another one (a finite-element reference)."""
-    from ctmrpim.methods import get
-
-    package = get(name).solve.__module__.split(".")[0]
-    if package == "ctmrpim":
-        return code_version()
-    other = Path(sys.modules[package].__file__).parent
-    return f"{code_version()}+{package}-{source_hash(other)[:16]}"

@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
-from ctmrpim import __version__
 from ctmrpim.io.atomic import atomic_write_text
 from ctmrpim.result import Result
+from ctmrpim.version import __version__
 
 
 def to_jsonable(obj: Any) -> Any:

@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ctmrpim.errors import ProblemError
+from ctmrpim.materials.linear_elastic import LinearElastic
 from ctmrpim.problem.expressions import Field
 from ctmrpim.problem.geometry import Geometry
-from ctmrpim.materials.linear_elastic import LinearElastic
 
 
 @dataclass

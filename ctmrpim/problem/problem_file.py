@@ -11,23 +11,32 @@ import copy
 import difflib
 import math
 import tomllib
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ctmrpim.errors import ProblemError
-from ctmrpim.problem.expressions import Field, constant
-from ctmrpim.problem.geometry import CIRCLE_SAGITTA, Geometry, Shape
-from ctmrpim.materials.neo_hookean import NeoHookean
 from ctmrpim.materials.linear_elastic import LinearElastic
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
+from ctmrpim.materials.neo_hookean import NeoHookean
 from ctmrpim.problem.case import Case
+from ctmrpim.problem.expressions import Field, constant
+from ctmrpim.problem.geometry import CIRCLE_SAGITTA, Geometry, Shape
+from ctmrpim.problem.model import (
+    NO_SLIP,
+    Constraint,
+    ExactSolution,
+    PointLoad,
+    Pressure,
+    Probe,
+    Problem,
+    Traction,
+    Wall,
+)
 from ctmrpim.problem.node_cloud import NodeSpec
 from ctmrpim.problem.settings import Explicit, Loading, Method, Relaxation, StrengthReduction
-from ctmrpim.problem.model import Constraint, ExactSolution, PointLoad, Pressure, Probe, Problem, Traction
-from ctmrpim.problem.model import NO_SLIP, Wall
 
 SECTIONS: dict[str, set[str] | None] = {
     "problem": {"name", "analysis", "plane", "thickness", "description", "gravity"},

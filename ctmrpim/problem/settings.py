@@ -11,7 +11,6 @@ turns them into lengths once d_c is known, the only place where that happens.
 """
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import asdict, dataclass, field
 from typing import Any, Iterable

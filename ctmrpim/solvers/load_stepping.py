@@ -23,7 +23,6 @@ import scipy.sparse as sp
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.settings import Loading
 
-
 #: Newton has diverged when a later step exceeds this many times both the increment's first step and
 #: the converged displacement: a mechanism (a failed slope, a footing past its limit load), not slow
 #: convergence, so the increment is cut back at once instead of using up its iterations.

@@ -1,4 +1,4 @@
-"""The CTM-RPIM method (``"ctm-rpim"`` in :mod:`ctmrpim.methods`): each analysis to its solver.
+"""The CTM-RPIM method (``"ctm-rpim"`` of :mod:`ctmrpim.methods`): each analysis to its solver.
 
 | analysis | material | solver |
 |---|---|---|
@@ -14,9 +14,9 @@ import tempfile
 from pathlib import Path
 
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
-from ctmrpim.methods import RunOptions, register
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result
+from ctmrpim.run_options import RunOptions
 
 
 def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Result:
@@ -30,7 +30,7 @@ def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Resu
         return solve_explicit(case, options.out, options.resume, options.progress_bar)
     if analysis in ("strength-reduction", "dynamic") or (analysis == "quasi-static"
                                                          and isinstance(case.problem.material, MohrCoulomb)):
-        from ctmrpim.solvers.elastoplastic import solve_elastoplastic   # small strain: never re-tracked
+        from ctmrpim.solvers.elastoplastic import solve_elastoplastic  # small strain: never re-tracked
         return solve_elastoplastic(case, options.progress)
     if analysis == "quasi-static":
         if case.method.formulation == "updated-lagrangian":
@@ -41,6 +41,3 @@ def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Resu
     from ctmrpim.solvers.linear_static import solve_ctmrpim
     return solve_ctmrpim(case)
 
-
-register("ctm-rpim", solve_meshfree, description="adaptive CTM-RPIM (CTM integration, RPIM shape functions, "
-                                                  "alpha-shape boundary)")

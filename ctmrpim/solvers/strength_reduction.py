@@ -33,16 +33,16 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any, Callable
 
 import numpy as np
 
-from ctmrpim.problem.settings import Relaxation, StrengthReduction
-from ctmrpim.solvers.dynamic_relaxation import max_displacement, relax
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
+from ctmrpim.problem.settings import Relaxation, StrengthReduction
 from ctmrpim.result import Result
+from ctmrpim.solvers.dynamic_relaxation import max_displacement, relax
 
 CRITERION = {"newton": "non-convergence: the equilibrium iteration (loading.tangent: Newton, or the elastic "
                        "stiffness with Anderson mixing) did not reach the residual and displacement tolerance within "

@@ -17,17 +17,17 @@ import scipy.sparse as sp
 
 from ctmrpim.discretisation import assembly
 from ctmrpim.discretisation.boundary_loads import BoundaryLoads
+from ctmrpim.discretisation.configuration import build_configuration
+from ctmrpim.discretisation.lagrangian_operators import gradient_operator
+from ctmrpim.discretisation.rpim import shape_functions
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.neo_hookean import NeoHookean
-from ctmrpim.solvers.linear_solver import solve_constrained
-from ctmrpim.solvers.load_stepping import step_loads
-from ctmrpim.discretisation.lagrangian_operators import gradient_operator
-from ctmrpim.solvers.weak_form import internal_force, tangent
-from ctmrpim.timing import Timer
-from ctmrpim.discretisation.configuration import build_configuration
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result, probe_record
-from ctmrpim.discretisation.rpim import shape_functions
+from ctmrpim.solvers.linear_solver import solve_constrained
+from ctmrpim.solvers.load_stepping import step_loads
+from ctmrpim.solvers.weak_form import internal_force, tangent
+from ctmrpim.timing import Timer
 
 
 def _cauchy(material: NeoHookean, G: sp.csr_matrix, U: np.ndarray) -> np.ndarray:

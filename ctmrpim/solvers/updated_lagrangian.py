@@ -41,21 +41,29 @@ from scipy.spatial import cKDTree
 from ctmrpim.discretisation import assembly
 from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape
 from ctmrpim.discretisation.boundary_loads import BoundaryLoads
-from ctmrpim.discretisation.ctm import integration_points
-from ctmrpim.errors import ProblemError
-from ctmrpim.materials.neo_hookean import NeoHookean
-from ctmrpim.discretisation.lagrangian_operators import gradient_operator
-from ctmrpim.solvers.weak_form import internal_force, tangent
-from ctmrpim.solvers.linear_solver import solve_constrained
 from ctmrpim.discretisation.configuration import Configuration, build_configuration
-from ctmrpim.timing import Timer
-from ctmrpim.solvers.load_stepping import step_loads
-from ctmrpim.materials.linear_elastic import LinearElastic
-from ctmrpim.materials.objective_stress import HypoelasticUpdate, LeftCauchyGreenUpdate, check_orientation, complex_step_tangent, det2, inv2, largest_strain
-from ctmrpim.problem.case import Case
-from ctmrpim.result import Result, probe_record
+from ctmrpim.discretisation.ctm import integration_points
+from ctmrpim.discretisation.lagrangian_operators import gradient_operator
 from ctmrpim.discretisation.rpim import shape_functions
 from ctmrpim.discretisation.state_transfer import project_to_nodes, transfer
+from ctmrpim.errors import ProblemError
+from ctmrpim.materials.linear_elastic import LinearElastic
+from ctmrpim.materials.neo_hookean import NeoHookean
+from ctmrpim.materials.objective_stress import (
+    HypoelasticUpdate,
+    LeftCauchyGreenUpdate,
+    check_orientation,
+    complex_step_tangent,
+    det2,
+    inv2,
+    largest_strain,
+)
+from ctmrpim.problem.case import Case
+from ctmrpim.result import Result, probe_record
+from ctmrpim.solvers.linear_solver import solve_constrained
+from ctmrpim.solvers.load_stepping import step_loads
+from ctmrpim.solvers.weak_form import internal_force, tangent
+from ctmrpim.timing import Timer
 
 #: Largest relative change of the tracked area from one configuration to the next (DESIGN.md).
 AREA_JUMP = 0.02

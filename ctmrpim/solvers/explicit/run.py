@@ -101,25 +101,46 @@ from scipy.spatial import cKDTree
 
 from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape
 from ctmrpim.discretisation.boundary_conditions import constrained_dofs
-from ctmrpim.io.checkpoint import NAME as CHECKPOINT, load_checkpoint, save_checkpoint
-from ctmrpim.solvers.explicit.time_step import ITERATIONS, WARM_ITERATIONS, checkerboard, omega_max, stable_step, wave_speed_step
-from ctmrpim.discretisation.ctm import integration_points
-from ctmrpim.errors import ProblemError
-from ctmrpim.materials.mohr_coulomb_kernel import PointUpdate, point_update
-from ctmrpim.problem.settings import Explicit
-from ctmrpim.discretisation.gradient_operator import GradientOperator
-from ctmrpim.timing import Timer
 from ctmrpim.discretisation.configuration import discretise
+from ctmrpim.discretisation.ctm import integration_points
+from ctmrpim.discretisation.gradient_operator import GradientOperator
 from ctmrpim.discretisation.lumped_mass import lumped_mass
-from ctmrpim.materials.mohr_coulomb import ELASTIC, MohrCoulomb, elastic_strain, equivalent_plastic_strain, plastic_strain_increment
-from ctmrpim.materials.objective_stress import det_c, first_piola_c, hughes_winget_c, largest_strain_c, relative_c, rotate_c
-from ctmrpim.io.vtu import SeriesWriter
-from ctmrpim.problem.case import Case
-from ctmrpim.result import Result
 from ctmrpim.discretisation.rpim import shape_functions
 from ctmrpim.discretisation.state_transfer import NodalProjection
+from ctmrpim.errors import ProblemError
+from ctmrpim.io.checkpoint import NAME as CHECKPOINT
+from ctmrpim.io.checkpoint import load_checkpoint, save_checkpoint
+from ctmrpim.io.vtu import SeriesWriter
+from ctmrpim.materials.mohr_coulomb import (
+    ELASTIC,
+    MohrCoulomb,
+    elastic_strain,
+    equivalent_plastic_strain,
+    plastic_strain_increment,
+)
+from ctmrpim.materials.mohr_coulomb_kernel import PointUpdate, point_update
+from ctmrpim.materials.objective_stress import (
+    det_c,
+    first_piola_c,
+    hughes_winget_c,
+    largest_strain_c,
+    relative_c,
+    rotate_c,
+)
+from ctmrpim.problem.case import Case
 from ctmrpim.problem.model import Wall
+from ctmrpim.problem.settings import Explicit
+from ctmrpim.result import Result
 from ctmrpim.solvers.explicit.contact import enforce_walls
+from ctmrpim.solvers.explicit.time_step import (
+    ITERATIONS,
+    WARM_ITERATIONS,
+    checkerboard,
+    omega_max,
+    stable_step,
+    wave_speed_step,
+)
+from ctmrpim.timing import Timer
 
 #: Largest |grad N| d_c of a point that integrates: regular clouds give 1.2 to 1.7, a thinned flow front
 #: up to about 7; 40 to 60 was measured at points left beyond the nodes of a front (spurious stiffness
