@@ -20,7 +20,7 @@ BLOCK = Path(__file__).parent / "data" / "mc_block.toml"
 def plateau_reaction(phi: float, psi: float = 0.0) -> tuple[float, float, object]:
     case = load_case(str(BLOCK), [f"parameters.phi={phi!r}", f"material.psi={psi!r}"])
     mat = case.problem.material
-    system, _ = elastoplastic.ctm_plastic_system(case, Timer())
+    system = elastoplastic.ctm_plastic_system(case, Timer())[0]
     system.run(case.loading, lambda t: mat, lambda t: t, lambda t, U: {})
     top = np.isclose(system_points(case), 1.0)
     reaction = -system.internal_force().reshape(-1, 2)[top, 1].sum()     # compressive force on the 1 m wide top
@@ -29,8 +29,8 @@ def plateau_reaction(phi: float, psi: float = 0.0) -> tuple[float, float, object
 
 
 def system_points(case) -> np.ndarray:
-    from ctmrpim.discretisation.configuration import discretise
-    return discretise(case, Timer()).nodes[:, 1]
+    from ctmrpim.discretisation.configuration import reference_cloud
+    return reference_cloud(case, Timer()).nodes[:, 1]
 
 
 @pytest.mark.parametrize("phi, psi, key", [(0.001, 0.0, "mc-block-tresca-plateau"), (30.0, 0.0, "mc-block-plateau"),

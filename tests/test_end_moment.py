@@ -30,18 +30,17 @@ def test_follower_loads_need_a_large_deformation_analysis() -> None:
 def test_face_follower_tractions_stay_a_couple() -> None:
     """follower = "face": both half-face tractions turn with the chord of the whole end face, so at
     any displacement their nodal forces sum to zero (a pure couple) and turn rigidly."""
-    from ctmrpim.discretisation.boundary_loads import BoundaryLoads
-    from ctmrpim.discretisation.configuration import build_configuration
+    from ctmrpim.discretisation.boundary_loads import reference_loads
+    from ctmrpim.discretisation.configuration import boundary_tags, reference_configuration
     from ctmrpim.timing import Timer
 
     case = benchmarks.load("end-moment", ["parameters.m=0.25"])
-    conf = build_configuration(case, Timer())
-    X, q = conf.disc.nodes, conf.traction
+    conf = reference_configuration(case, Timer())
+    tags = boundary_tags(case, conf.x, conf.boundary, conf.lengths)
+    X, q = conf.x, tags.traction
     corners = {int(np.argmin(np.hypot(X[:, 0] - L, X[:, 1] - y))) for y in (-0.25, 0.25)}
     assert {frozenset(map(int, pair)) for pair in q.turn_ends} == {frozenset(corners)}
-    turn = q.turn_ends
-    loads = BoundaryLoads(conf.sf_traction.N, q.weights, conf.tx, conf.ty, turn, q.follower,
-                          X[turn[:, 1]] - X[turn[:, 0]], np.zeros(X.size))
+    loads = reference_loads(conf, tags, 1.0, np.zeros(X.size))
     F0, _ = loads.forces(X, 1.0)
     rng = np.random.default_rng(0)
     theta = 1.1

@@ -67,20 +67,6 @@ def load_vector(N: sp.csr_matrix, weights: np.ndarray, tx: np.ndarray, ty: np.nd
     return np.column_stack([N.T @ (tx * weights), N.T @ (ty * weights)]).ravel()
 
 
-def point_load_vector(nodes: np.ndarray, problem, rpim: dict) -> np.ndarray:
-    """Concentrated forces f at points x_p: F = sum_p N(x_p)^T f_p (the Kronecker delta property puts a
-    load at a node on that node alone)."""
-    from ctmrpim.discretisation.rpim import shape_functions
-
-    F = np.zeros(2 * len(nodes))
-    if problem.point_loads:
-        xy = np.array([[p.x, p.y] for p in problem.point_loads])
-        N = shape_functions(nodes, xy, derivatives=False, **rpim).N
-        F += load_vector(N, np.ones(len(xy)), np.array([p.fx for p in problem.point_loads]),
-                         np.array([p.fy for p in problem.point_loads]))
-    return F
-
-
 def body_force_vector(N: sp.csr_matrix, weights: np.ndarray, problem) -> np.ndarray:
     """F = sum_p N_p^T b w_p over the integration points, b = density * gravity (Eq. 6, body term);
     ``weights`` include the thickness."""

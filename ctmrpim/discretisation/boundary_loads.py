@@ -17,6 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ctmrpim.discretisation import assembly
+from ctmrpim.discretisation.configuration import BoundaryTags, Configuration
 from ctmrpim.discretisation.lagrangian_operators import difference_operator, value_operator
 
 
@@ -60,3 +61,14 @@ class BoundaryLoads:
         K = value_operator(self.N).T @ (MB @ difference_operator(ends, n_nodes=len(x)))
         F = factor * (assembly.load_vector(self.N, self.weights, rx, ry) + self.F_points)
         return F, -K.tocsr()
+
+
+def reference_loads(conf: Configuration, tags: BoundaryTags, thickness: float, point_forces: np.ndarray
+                    ) -> BoundaryLoads:
+    """The loads of the reference configuration ``conf``: the tagged tractions (follower ones turning
+    with their node pairs) and the point forces (2n,) per unit thickness, all times ``thickness``."""
+    q = tags.traction
+    turn = q.turn_ends
+    N = conf.shape_functions_at(q.points, derivatives=False).N
+    return BoundaryLoads(N, q.weights * thickness, tags.tx, tags.ty, turn, q.follower,
+                         conf.x[turn[:, 1]] - conf.x[turn[:, 0]], thickness * point_forces)

@@ -1,22 +1,41 @@
-"""The node cloud of a case in its reference configuration, and everything built on it (Sections 2.2-2.4).
+"""One configuration of the node cloud and everything built on it (Sections 2.2-2.4), for every solver.
 
-field nodes --alpha shape--> boundary loops --CTM--> integration points and weights
-            --boundary Gauss--> traction points --RPIM--> sparse shape functions
+    field nodes --alpha shape--> boundary loops --CTM--> integration points and weights
+                --RPIM--> sparse shape functions and gradients at the points
+
+A :class:`Configuration` is what scikit-fem calls a basis: the node positions it was built on, the
+method's lengths for the cloud's spacing (:meth:`ctmrpim.problem.settings.Method.scaled`), the
+tracked boundary, the integration points with their weights (thickness included) and the RPIM shape
+functions there. The linear, total-Lagrangian and elastoplastic solvers build one on the reference
+cloud (:func:`reference_configuration`); the updated-Lagrangian and explicit solvers build one at
+every rebuild (:func:`build`), on the current node positions, at new CTM points laid over the
+re-tracked boundary (:func:`lay_points`) or at the points the body carried.
+
+The reference configuration also fixes the tags that travel with the nodes (:class:`BoundaryTags`):
+constrained dofs and the loaded boundary's Gauss points, selected once by the problem's ``where``
+expressions.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from ctmrpim.discretisation import assembly
 from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape, validate
 from ctmrpim.discretisation.boundary_conditions import constrained_dofs, loaded_boundary
 from ctmrpim.discretisation.ctm import BoundaryQuadrature, Quadrature, integration_points
+from ctmrpim.discretisation.gradient_operator import GradientOperator
+from ctmrpim.discretisation.lagrangian_operators import gradient_operator
 from ctmrpim.discretisation.rpim import ShapeFunctions, shape_functions
 from ctmrpim.errors import ProblemError
+from ctmrpim.materials.objective_stress import inv2
 from ctmrpim.problem.case import Case
+from ctmrpim.problem.model import Problem
 from ctmrpim.problem.node_cloud import check_nodes_inside, make_nodes, mean_node_spacing
+from ctmrpim.problem.settings import ScaledMethod
 from ctmrpim.timing import Timer
 
 #: The tracked boundary may differ from the geometry's area by this many d_c times its perimeter.
@@ -24,68 +43,191 @@ AREA_TOLERANCE = 0.05
 
 
 @dataclass
-class Discretisation:
-    nodes: np.ndarray
-    d_c: float
+class Configuration:
+    """Everything built on one configuration ``x`` of the node cloud.
+
+    ``x`` (n, 2) node positions; ``points`` (m, 2) integration points and ``w`` (m,) their weights,
+    thickness included; ``sf`` the RPIM shape functions there, (m, n) sparse rows; ``active`` the
+    nodes of the body (the others are free particles that the shape functions never touch; None:
+    all); ``quadrature`` the CTM lines the points were laid on (None for points the body carried)."""
+
+    x: np.ndarray
+    lengths: ScaledMethod
     boundary: Boundary
-    quadrature: Quadrature
+    points: np.ndarray
+    w: np.ndarray
+    sf: ShapeFunctions
+    tree: cKDTree
+    active: np.ndarray | None = None
+    quadrature: Quadrature | None = None
+    _G: sp.bsr_matrix | None = field(default=None, repr=False)
+    _grad: GradientOperator | None = field(default=None, repr=False)
+
+    @property
+    def N(self) -> sp.csr_matrix:
+        """(m, n) shape-function values at the points."""
+        return self.sf.N
+
+    @property
+    def free(self) -> np.ndarray:
+        """(n,) bool: the free particles (nodes outside the body)."""
+        out = np.zeros(len(self.x), bool)
+        if self.active is not None:
+            out[:] = True
+            out[self.active] = False
+        return out
+
+    def shape_functions_at(self, points: np.ndarray, derivatives: bool = True, **options) -> ShapeFunctions:
+        """RPIM of this configuration's nodes at other ``points`` (k, 2): probes, tractions, error points
+        (``options``: ``reference`` or the other keywords of :func:`~ctmrpim.discretisation.rpim.shape_functions`)."""
+        return shape_functions(self.x, points, derivatives=derivatives, tree=self.tree, **options,
+                               **self.lengths.rpim())
+
+    def point_forces(self, problem: Problem) -> np.ndarray:
+        """(2n,) interleaved: the problem's concentrated forces per unit thickness, F = sum_p N(x_p)^T f_p
+        (the Kronecker delta property puts a load at a node on that node alone)."""
+        F = np.zeros(2 * len(self.x))
+        if problem.point_loads:
+            xy = np.array([[p.x, p.y] for p in problem.point_loads])
+            F += assembly.load_vector(self.shape_functions_at(xy, derivatives=False).N, np.ones(len(xy)),
+                                      np.array([p.fx for p in problem.point_loads]),
+                                      np.array([p.fy for p in problem.point_loads]))
+        return F
+
+    def block_gradient(self) -> sp.bsr_matrix:
+        """G (4m x 2n), the weak form's gradient operator (:mod:`ctmrpim.solvers.weak_form`), built once."""
+        if self._G is None:
+            self._G = gradient_operator(self.sf.dNdx, self.sf.dNdy)
+        return self._G
+
+    def compiled_gradient(self) -> GradientOperator:
+        """The compiled gradient and force products of explicit dynamics, built once."""
+        if self._grad is None:
+            self._grad = GradientOperator(self.sf.dNdx, self.sf.dNdy)
+        return self._grad
+
+    def carried(self, x: np.ndarray, points: np.ndarray, w: np.ndarray, f: np.ndarray) -> Configuration:
+        """This configuration moved with the body, without a rebuild: nodes at ``x`` (n, 2), points at
+        ``points`` (m, 2) with weights ``w`` (m,), and the gradients mapped by the relative deformation
+        gradients ``f`` (m, 2, 2) of the move, grad N_{n+1} = grad N_n f^-1; the values N do not change
+        (the total-Lagrangian form relative to this configuration)."""
+        finv = inv2(f)
+        dx, dy = self.sf.dNdx, self.sf.dNdy
+        rows = np.repeat(np.arange(dx.shape[0]), np.diff(dx.indptr))
+        data_x = dx.data * finv[rows, 0, 0] + dy.data * finv[rows, 1, 0]
+        data_y = dx.data * finv[rows, 0, 1] + dy.data * finv[rows, 1, 1]
+        sf = ShapeFunctions(self.sf.N, sp.csr_matrix((data_x, dx.indices, dx.indptr), shape=dx.shape),
+                            sp.csr_matrix((data_y, dx.indices, dx.indptr), shape=dx.shape),
+                            self.sf.support_sizes, self.sf.dropped)
+        return replace(self, x=x, points=points, w=w, sf=sf, _G=None, _grad=None)
+
+    def moved_points(self, x: np.ndarray) -> np.ndarray:
+        """(m, 2) where the points are when the nodes have moved from this configuration's positions to ``x``."""
+        return self.points + np.asarray(self.sf.N @ (x - self.x))
+
+    def gradient(self, d: np.ndarray) -> np.ndarray:
+        """(m, 4) F = I + grad d (xx, xy, yx, yy) of nodal displacements d (n, 2) relative to ``x``."""
+        return self.compiled_gradient().gradient(d)
+
+    def force(self, P: np.ndarray) -> np.ndarray:
+        """(n, 2) sum_p w_p P_p grad N of first Piola stresses P (m, 4: xX, xY, yX, yY) relative to ``x``."""
+        return self.compiled_gradient().force(P * self.w[:, None])
 
 
-def track_boundary(case: Case, nodes: np.ndarray, d_c: float) -> Boundary:
+def build(x: np.ndarray, boundary: Boundary, points: np.ndarray, w: np.ndarray, lengths: ScaledMethod, *,
+          quadrature: Quadrature | None = None, active: np.ndarray | None = None,
+          reference: tuple[np.ndarray, np.ndarray, float] | None = None, min_nodes: int = 0,
+          drop_singular: bool = False) -> Configuration:
+    """The RPIM shape functions of the nodes ``x`` (n, 2) at ``points`` (m, 2) with weights ``w`` (m,):
+    a :class:`Configuration`. ``active`` limits the RPIM cloud to those nodes (the shape functions are
+    still indexed by all n); ``reference``, ``min_nodes`` and ``drop_singular`` are passed to
+    :func:`~ctmrpim.discretisation.rpim.shape_functions`."""
+    cloud = x if active is None else x[active]
+    tree = cKDTree(cloud)
+    sf = shape_functions(cloud, points, tree=tree, reference=reference, min_nodes=min_nodes,
+                         drop_singular=drop_singular, **lengths.rpim())
+    if active is not None:
+        shape = (len(points), len(x))
+        N, dx, dy = (sp.csr_matrix((M.data, active[M.indices], M.indptr), shape=shape)
+                     for M in (sf.N, sf.dNdx, sf.dNdy))
+        sf = ShapeFunctions(N, dx, dy, sf.support_sizes, sf.dropped)
+    return Configuration(x, lengths, boundary, points, w, sf, tree, active, quadrature)
+
+
+def lay_points(loops: list[np.ndarray], lengths: ScaledMethod, thickness: float) -> tuple[Quadrature, np.ndarray]:
+    """The paper's CTM points over closed ``loops`` (each (k, 2)): lines every r_y, sub-segments of r_x
+    (Eqs. 12-24); the quadrature and the weights (m,) times the thickness."""
+    quad = integration_points(loops, lengths.r_x, lengths.r_y, lengths.gauss_points, mode="uniform")
+    return quad, quad.weights * thickness
+
+
+@dataclass
+class ReferenceCloud:
+    """The case's field nodes (n, 2) in the reference configuration, their method lengths and boundary."""
+
+    nodes: np.ndarray
+    lengths: ScaledMethod
+    boundary: Boundary
+
+    @property
+    def d_c(self) -> float:
+        return self.lengths.d_c
+
+
+def track_boundary(case: Case, nodes: np.ndarray, lengths: ScaledMethod) -> Boundary:
     """The body's boundary from the node cloud (alpha shape), checked against the geometry's area."""
     geometry = case.problem.geometry
-    boundary = alpha_shape(nodes, case.method.alpha * d_c, d_c)
+    boundary = alpha_shape(nodes, lengths.alpha, lengths.d_c)
     if len(boundary.detached):
         i = boundary.detached[0]
         raise ProblemError(f"{len(boundary.detached)} node(s) are outside the alpha shape, e.g. #{i} at "
                            f"({nodes[i, 0]:g}, {nodes[i, 1]:g}); increase method.alpha", key="method.alpha")
-    validate(boundary, expected_area=geometry.area, area_tol=AREA_TOLERANCE * d_c * geometry.perimeter)
+    validate(boundary, expected_area=geometry.area, area_tol=AREA_TOLERANCE * lengths.d_c * geometry.perimeter)
     return boundary
 
 
-def discretise(case: Case, timer: Timer) -> Discretisation:
-    geometry, method = case.problem.geometry, case.method
+def reference_cloud(case: Case, timer: Timer) -> ReferenceCloud:
+    """The case's nodes, d_c (Eq. 36) and the method's lengths, and the tracked boundary."""
+    geometry = case.problem.geometry
     nodes = make_nodes(geometry, case.nodes, case.base_dir)
-    d_c = mean_node_spacing(geometry.area, len(nodes))
-    check_nodes_inside(geometry, nodes, tol=method.match_tolerance * d_c)
-    boundary = track_boundary(case, nodes, d_c)
+    lengths = case.method.scaled(mean_node_spacing(geometry.area, len(nodes)))
+    check_nodes_inside(geometry, nodes, tol=lengths.match_tolerance)
+    boundary = track_boundary(case, nodes, lengths)
     timer.lap("boundary")
-    loops = boundary.loop_coordinates() if method.boundary == "alpha" else geometry.loops()
-    r_x, r_y = (s * d_c for s in method.line_spacing)
-    quad = integration_points(loops, r_x, r_y, method.gauss_points, mode="uniform")
+    return ReferenceCloud(nodes, lengths, boundary)
+
+
+def reference_configuration(case: Case, timer: Timer) -> Configuration:
+    """The :class:`Configuration` of the reference cloud, its CTM points laid over the tracked boundary
+    (``method.boundary = "alpha"``) or the exact geometry (``"geometry"``)."""
+    cloud = reference_cloud(case, timer)
+    loops = cloud.boundary.loop_coordinates() if case.method.boundary == "alpha" else case.problem.geometry.loops()
+    quad, w = lay_points(loops, cloud.lengths, case.problem.thickness)
     timer.lap("integration")
-    return Discretisation(nodes=nodes, d_c=d_c, boundary=boundary, quadrature=quad)
+    conf = build(cloud.nodes, cloud.boundary, quad.points, w, cloud.lengths, quadrature=quad)
+    timer.lap("shape_functions")
+    return conf
 
 
 @dataclass
-class Configuration:
-    """Everything built on one configuration of the node cloud: boundary, integration points, the
-    constrained dofs, the loaded boundary points and the RPIM shape functions at both sets of points."""
+class BoundaryTags:
+    """What the problem's selectors picked on the reference configuration: the boundary nodes, the
+    constrained dofs (interleaved) with their values, and the loaded boundary's Gauss points (t of
+    them) with the traction components (t,) there."""
 
-    disc: Discretisation
     boundary_nodes: np.ndarray
     fixed: np.ndarray
     fixed_values: np.ndarray
     traction: BoundaryQuadrature
     tx: np.ndarray
     ty: np.ndarray
-    rpim: dict
-    sf: ShapeFunctions
-    sf_traction: ShapeFunctions
 
 
-def build_configuration(case: Case, timer: Timer) -> Configuration:
-    problem, method = case.problem, case.method
-    disc = discretise(case, timer)
-    nodes, d_c = disc.nodes, disc.d_c
-    tol = method.match_tolerance * d_c
-    boundary_nodes = np.unique(np.concatenate(disc.boundary.loops))
-    fixed, fixed_values = constrained_dofs(problem, nodes, boundary_nodes, tol)
-    traction_q, tx, ty = loaded_boundary(problem, nodes, disc.boundary.edges, tol)
-    timer.lap("integration")
-    rpim = dict(support_radius=method.support_radius * d_c, eta=method.eta,
-                polynomial_terms=method.polynomial_terms, scale=d_c, tree=cKDTree(nodes))
-    sf = shape_functions(nodes, disc.quadrature.points, **rpim)
-    sf_t = shape_functions(nodes, traction_q.points, derivatives=False, **rpim)
-    timer.lap("shape_functions")
-    return Configuration(disc, boundary_nodes, fixed, fixed_values, traction_q, tx, ty, rpim, sf, sf_t)
+def boundary_tags(case: Case, nodes: np.ndarray, boundary: Boundary, lengths: ScaledMethod) -> BoundaryTags:
+    """Evaluate the case's constraints and loads on the ``boundary`` of the reference ``nodes`` (n, 2),
+    once: the tags then travel with the nodes."""
+    tol = lengths.match_tolerance
+    boundary_nodes = np.unique(np.concatenate(boundary.loops))
+    fixed, fixed_values = constrained_dofs(case.problem, nodes, boundary_nodes, tol)
+    traction, tx, ty = loaded_boundary(case.problem, nodes, boundary.edges, tol)
+    return BoundaryTags(boundary_nodes, fixed, fixed_values, traction, tx, ty)

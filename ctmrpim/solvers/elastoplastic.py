@@ -12,10 +12,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ctmrpim.discretisation import assembly
-from ctmrpim.discretisation.boundary_loads import BoundaryLoads
-from ctmrpim.discretisation.configuration import build_configuration
-from ctmrpim.discretisation.lagrangian_operators import gradient_operator
-from ctmrpim.discretisation.rpim import shape_functions
+from ctmrpim.discretisation.boundary_loads import reference_loads
+from ctmrpim.discretisation.configuration import boundary_tags, reference_configuration
 from ctmrpim.discretisation.state_transfer import NodalProjection
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
@@ -27,35 +25,31 @@ from ctmrpim.timing import Timer
 
 def ctm_plastic_system(case: Case, timer: Timer):
     """The CTM-RPIM discretisation of a Mohr-Coulomb Case as a :class:`PlasticSystem`, with the
-    configuration it was built on."""
+    configuration it was built on and the boundary tags of that configuration."""
     problem = case.problem
     if not isinstance(problem.material, MohrCoulomb):
         raise ProblemError("the elastoplastic solver needs model = \"mohr-coulomb\"", key="material.model")
     if any(t.follower for t in problem.tractions):
         raise ProblemError("follower loads need a large-deformation material; the Mohr-Coulomb solver is "
                            "small-strain", key="traction")
-    conf = build_configuration(case, timer)
-    nodes, quad, sf = conf.disc.nodes, conf.disc.quadrature, conf.sf
-    w = quad.weights * problem.thickness
-    q = conf.traction
-    loads = BoundaryLoads(conf.sf_traction.N, q.weights * problem.thickness, conf.tx, conf.ty, q.ends, q.follower,
-                          nodes[q.ends[:, 1]] - nodes[q.ends[:, 0]],
-                          problem.thickness * assembly.point_load_vector(nodes, problem, conf.rpim))
-    system = PlasticSystem(gradient_operator(sf.dNdx, sf.dNdy), w, conf.fixed, conf.fixed_values,
-                           lambda factor: loads.forces(nodes, factor)[0],
-                           assembly.body_force_vector(sf.N, w, problem), problem.material,
+    conf = reference_configuration(case, timer)
+    tags = boundary_tags(case, conf.x, conf.boundary, conf.lengths)
+    loads = reference_loads(conf, tags, problem.thickness, conf.point_forces(problem))
+    system = PlasticSystem(conf.block_gradient(), conf.w, tags.fixed, tags.fixed_values,
+                           lambda factor: loads.forces(conf.x, factor)[0],
+                           assembly.body_force_vector(conf.N, conf.w, problem), problem.material,
                            tangent=case.loading.tangent)
-    return system, conf
+    return system, conf, tags
 
 
 def solve_elastoplastic(case: Case, progress: Callable[[Any], None] = lambda level: None) -> Result:
     """:func:`run_elastoplastic` with CTM-RPIM."""
     problem = case.problem
     timer = Timer()
-    system, conf = ctm_plastic_system(case, timer)
-    nodes, sf = conf.disc.nodes, conf.sf
+    system, conf, tags = ctm_plastic_system(case, timer)
+    nodes, sf = conf.x, conf.sf
     probe_xy = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
-    sf_p = shape_functions(nodes, probe_xy, derivatives=False, **conf.rpim) if len(probe_xy) else None
+    sf_p = conf.shape_functions_at(probe_xy, derivatives=False) if len(probe_xy) else None
     timer.lap("assembly")
 
     nodal = NodalProjection(sf.N, system.w)
@@ -70,10 +64,10 @@ def solve_elastoplastic(case: Case, progress: Callable[[Any], None] = lambda lev
     sizes = sf.support_sizes
     material = problem.material
     out = PlasticOutput(
-        method="ctm-rpim-mc", points=nodes, cells=[("line", conf.disc.boundary.edges)],
+        method="ctm-rpim-mc", points=nodes, cells=[("line", conf.boundary.edges)],
         displacement=lambda U: U.reshape(-1, 2).copy(), nodal=nodal, probe_values=probe_values,
-        peak_traction=float(np.hypot(conf.tx, conf.ty).max(initial=0.0)),
+        peak_traction=float(np.hypot(tags.tx, tags.ty).max(initial=0.0)),
         counts={"nodes": len(nodes), "integration_points": len(system.w),
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},
-        parameters={**case.resolved, "derived": {"d_c": conf.disc.d_c, "G": material.G, "K": material.K}})
+        parameters={**case.resolved, "derived": {"d_c": conf.lengths.d_c, "G": material.G, "K": material.K}})
     return run_elastoplastic(case, system, out, timer, progress)

@@ -9,9 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from ctmrpim.discretisation import assembly
-from ctmrpim.discretisation.configuration import build_configuration
+from ctmrpim.discretisation.configuration import boundary_tags, reference_configuration
 from ctmrpim.discretisation.ctm import integration_points
-from ctmrpim.discretisation.rpim import shape_functions
 from ctmrpim.problem.case import Case
 from ctmrpim.reference.error_norms import relative_errors
 from ctmrpim.result import Result, probe_errors, probe_record
@@ -28,29 +27,30 @@ def solve_ctmrpim(case: Case) -> Result:
     """Solve a linear-elastic Case with CTM-RPIM."""
     problem, method = case.problem, case.method
     timer = Timer()
-    conf = build_configuration(case, timer)
-    disc, rpim, sf, sf_t = conf.disc, conf.rpim, conf.sf, conf.sf_traction
-    nodes, d_c, quad = disc.nodes, disc.d_c, disc.quadrature
-    fixed, fixed_values, traction_q, tx, ty = conf.fixed, conf.fixed_values, conf.traction, conf.tx, conf.ty
-    boundary_nodes, tol = conf.boundary_nodes, method.match_tolerance * d_c
+    conf = reference_configuration(case, timer)
+    tags = boundary_tags(case, conf.x, conf.boundary, conf.lengths)
+    N_traction = conf.shape_functions_at(tags.traction.points, derivatives=False).N
+    timer.lap("shape_functions")
+    sf, nodes, d_c, quad, boundary = conf.sf, conf.x, conf.lengths.d_c, conf.quadrature, conf.boundary
+    fixed, fixed_values, traction_q = tags.fixed, tags.fixed_values, tags.traction
 
     D = problem.D()
-    K = assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights * problem.thickness, D)
-    F = assembly.load_vector(sf_t.N, traction_q.weights * problem.thickness, tx, ty)
-    F += problem.thickness * assembly.point_load_vector(nodes, problem, rpim)
-    F += assembly.body_force_vector(sf.N, quad.weights * problem.thickness, problem)
+    K = assembly.stiffness(sf.dNdx, sf.dNdy, conf.w, D)
+    F = assembly.load_vector(N_traction, traction_q.weights * problem.thickness, tags.tx, tags.ty)
+    F += problem.thickness * conf.point_forces(problem)
+    F += assembly.body_force_vector(sf.N, conf.w, problem)
     timer.lap("assembly")
 
     U = solve_constrained(K, F, fixed, fixed_values, method.solver)
     u = U.reshape(-1, 2)
     timer.lap("solve")
 
-    sf_n = shape_functions(nodes, nodes, **rpim)
+    sf_n = conf.shape_functions_at(nodes)
     stress = assembly.strain(sf_n.dNdx, sf_n.dNdy, u) @ D.T
     probes = {}
     if problem.probes:
         pp = np.array([[p.x, p.y] for p in problem.probes])
-        sf_p = shape_functions(nodes, pp, **rpim)
+        sf_p = conf.shape_functions_at(pp)
         up = sf_p.N @ u
         sp_ = assembly.strain(sf_p.dNdx, sf_p.dNdy, u) @ D.T
         probes = {p.name: probe_record(p.x, p.y, up[i], sp_[i]) for i, p in enumerate(problem.probes)}
@@ -58,7 +58,7 @@ def solve_ctmrpim(case: Case) -> Result:
     if problem.exact is not None:
         eq = integration_points(problem.geometry.loops(), ERROR_CELL * d_c, ERROR_CELL * d_c, ERROR_GAUSS,
                                 mode="exact", min_band=ERROR_MIN_BAND * d_c)
-        sf_e = shape_functions(nodes, eq.points, **rpim)
+        sf_e = conf.shape_functions_at(eq.points)
         u_e = sf_e.N @ u
         s_e = assembly.strain(sf_e.dNdx, sf_e.dNdy, u) @ D.T
         errors = {**relative_errors(problem, eq.points, eq.weights, u_e, s_e),
@@ -68,18 +68,15 @@ def solve_ctmrpim(case: Case) -> Result:
     sizes = sf.support_sizes
     return Result(
         method="ctm-rpim", points=nodes, u=u, stress=stress,
-        cells=[("line", disc.boundary.edges)],
+        cells=[("line", boundary.edges)],
         probes=probes, errors=errors,
         counts={"nodes": len(nodes), "integration_points": len(quad.weights), "integration_lines": quad.n_lines,
-                "traction_points": len(traction_q.weights), "boundary_loops": len(disc.boundary.loops),
-                "boundary_nodes": len(boundary_nodes), "holes_filled": disc.boundary.filled_holes,
+                "traction_points": len(traction_q.weights), "boundary_loops": len(boundary.loops),
+                "boundary_nodes": len(tags.boundary_nodes), "holes_filled": boundary.filled_holes,
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())},
                 "dofs": 2 * len(nodes), "constrained_dofs": len(fixed), "stiffness_nonzeros": int(K.nnz)},
         timings=timer.total(),
-        parameters={**case.resolved, "derived": {
-            "d_c": d_c, "support_radius": method.support_radius * d_c,
-            "r_x": method.line_spacing[0] * d_c, "r_y": method.line_spacing[1] * d_c,
-            "alpha": method.alpha * d_c, "match_tolerance": tol,
-            "tracked_area": disc.boundary.area, "geometry_area": problem.geometry.area}},
+        parameters={**case.resolved, "derived": {**conf.lengths.derived(), "tracked_area": boundary.area,
+                                                 "geometry_area": problem.geometry.area}},
         defaults=case.defaults,
     )

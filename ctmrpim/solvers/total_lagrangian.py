@@ -15,11 +15,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ctmrpim.discretisation import assembly
-from ctmrpim.discretisation.boundary_loads import BoundaryLoads
-from ctmrpim.discretisation.configuration import build_configuration
+from ctmrpim.discretisation.boundary_loads import reference_loads
+from ctmrpim.discretisation.configuration import boundary_tags, reference_configuration
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator
-from ctmrpim.discretisation.rpim import shape_functions
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.neo_hookean import NeoHookean
 from ctmrpim.problem.case import Case
@@ -52,27 +50,23 @@ def solve_total_lagrangian(case: Case) -> Result:
         raise ProblemError("gravity is not in the large-deformation solvers yet (a Mohr-Coulomb or linear "
                            "analysis takes it)", key="problem.gravity")
     timer = Timer()
-    conf = build_configuration(case, timer)
-    disc, rpim, sf, sf_t = conf.disc, conf.rpim, conf.sf, conf.sf_traction
-    nodes, d_c, quad = disc.nodes, disc.d_c, disc.quadrature
-    fixed, fixed_values, traction_q, tx, ty = conf.fixed, conf.fixed_values, conf.traction, conf.tx, conf.ty
+    conf = reference_configuration(case, timer)
+    tags = boundary_tags(case, conf.x, conf.boundary, conf.lengths)
+    nodes, sf, w = conf.x, conf.sf, conf.w
+    fixed, fixed_values = tags.fixed, tags.fixed_values
     probe_xy = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
-    sf_p = shape_functions(nodes, probe_xy, **rpim) if len(probe_xy) else None
+    sf_p = conf.shape_functions_at(probe_xy) if len(probe_xy) else None
     timer.lap("shape_functions")
-    G = gradient_operator(sf.dNdx, sf.dNdy)
+    G = conf.block_gradient()
     GT = G.T
-    w = quad.weights * problem.thickness
-    wt = traction_q.weights * problem.thickness
-    follower = traction_q.follower
-    turn = traction_q.turn_ends
-    loads = BoundaryLoads(sf_t.N, wt, tx, ty, turn, follower, nodes[turn[:, 1]] - nodes[turn[:, 0]],
-                          problem.thickness * assembly.point_load_vector(nodes, problem, rpim))
+    follower = tags.traction.follower
+    loads = reference_loads(conf, tags, problem.thickness, conf.point_forces(problem))
 
     timer.lap("assembly")
 
     n = len(nodes)
     series: list[dict] = []
-    sf_n = shape_functions(nodes, nodes, **rpim)
+    sf_n = conf.shape_functions_at(nodes)
     G_nodes = gradient_operator(sf_n.dNdx, sf_n.dNdy)
 
     def assemble(U: np.ndarray, factor: float):
@@ -111,10 +105,10 @@ def solve_total_lagrangian(case: Case) -> Result:
     sizes = sf.support_sizes
     return Result(
         method="ctm-rpim-tl", points=nodes, u=u, stress=stress,
-        cells=[("line", disc.boundary.edges)], probes=probes, errors={},
+        cells=[("line", conf.boundary.edges)], probes=probes, errors={},
         counts={"nodes": n, "integration_points": len(w), "load_increments": sum(h["converged"] for h in history),
                 "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},
         timings=timer.total(), history=history, series=series,
-        parameters={**case.resolved, "derived": {"d_c": d_c, "mu": material.mu, "lambda": material.lam}},
+        parameters={**case.resolved, "derived": {"d_c": conf.lengths.d_c, "mu": material.mu, "lambda": material.lam}},
         defaults=case.defaults)

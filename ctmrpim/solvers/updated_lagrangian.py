@@ -41,10 +41,8 @@ from scipy.spatial import cKDTree
 from ctmrpim.discretisation import assembly
 from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape
 from ctmrpim.discretisation.boundary_loads import BoundaryLoads
-from ctmrpim.discretisation.configuration import Configuration, build_configuration
-from ctmrpim.discretisation.ctm import integration_points
-from ctmrpim.discretisation.lagrangian_operators import gradient_operator
-from ctmrpim.discretisation.rpim import shape_functions
+from ctmrpim.discretisation.configuration import BoundaryTags, boundary_tags, build, lay_points, reference_cloud
+from ctmrpim.discretisation.rpim import ShapeFunctions
 from ctmrpim.discretisation.state_transfer import project_to_nodes, transfer
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.linear_elastic import LinearElastic
@@ -55,10 +53,10 @@ from ctmrpim.materials.objective_stress import (
     check_orientation,
     complex_step_tangent,
     det2,
-    inv2,
     largest_strain,
 )
 from ctmrpim.problem.case import Case
+from ctmrpim.problem.settings import ScaledMethod
 from ctmrpim.result import Result, probe_record
 from ctmrpim.solvers.linear_solver import solve_constrained
 from ctmrpim.solvers.load_stepping import step_loads
@@ -109,17 +107,13 @@ class AdaptiveBody:
     """The node cloud in its current configuration with everything built on it, and the state at its
     integration points. ``trial`` evaluates an increment, ``commit`` accepts it and rebuilds."""
 
-    def __init__(self, case: Case, X: np.ndarray, d_c: float, update, traction: TractionTags,
+    def __init__(self, case: Case, X: np.ndarray, lengths: ScaledMethod, update, traction: TractionTags,
                  material_points: np.ndarray, point_forces: np.ndarray, timer: Timer):
-        method = case.method
-        self.case, self.X, self.d_c, self.update, self.traction, self.timer = case, X, d_c, update, traction, timer
+        self.case, self.X, self.lengths, self.update, self.traction, self.timer = (case, X, lengths, update, traction,
+                                                                                 timer)
         self.x = X.copy()
         self.U = np.zeros(X.size)                    # total displacement, interleaved
-        self.alpha = method.alpha * d_c
-        self.r_x, self.r_y = (s * d_c for s in method.line_spacing)
-        self.rpim = dict(support_radius=method.support_radius * d_c, eta=method.eta,
-                         polynomial_terms=method.polynomial_terms, scale=d_c)
-        self.far = REFERENCE_NEIGHBOURS * method.support_radius * d_c
+        self.far = REFERENCE_NEIGHBOURS * lengths.support_radius
         self.material_X = material_points.copy()   # probes, then point loads
         self.material_x = material_points.copy()
         self.point_forces = point_forces
@@ -128,7 +122,7 @@ class AdaptiveBody:
         self.transfers = 0
         self.skipped_rebuilds = 0
         self.areas: list[float] = []
-        self.regeneration = method.point_regeneration
+        self.regeneration = case.method.point_regeneration
         self._build()
         self.state = update.initial(len(self.w))
         self.nodal_state = update.initial(len(X))
@@ -136,8 +130,8 @@ class AdaptiveBody:
 
     # -- configuration -------------------------------------------------------------------------------
     def _track(self) -> tuple[Boundary, float]:
-        boundary = alpha_shape(self.x, self.alpha, self.d_c, reference=self.X,
-                               max_reference_edge=REFERENCE_NEIGHBOURS * self.alpha)
+        boundary = alpha_shape(self.x, self.lengths.alpha, self.lengths.d_c, reference=self.X,
+                               max_reference_edge=REFERENCE_NEIGHBOURS * self.lengths.alpha)
         if len(boundary.detached):
             i = boundary.detached[0]
             raise ProblemError(f"{len(boundary.detached)} node(s) left the alpha shape after rebuild {self.rebuilds}, "
@@ -179,32 +173,52 @@ class AdaptiveBody:
         positions)``, the integration points the body carried through the increment."""
         boundary, area = self._track()
         self.timer.lap("boundary")
+        quad = None
         if carried is None:
-            quad = integration_points(boundary.loop_coordinates(), self.r_x, self.r_y,
-                                      self.case.method.gauss_points, mode="uniform")
-            points, w = quad.points, quad.weights * self.thickness
+            quad, w = lay_points(boundary.loop_coordinates(), self.lengths, self.thickness)
+            points = quad.points
             ref = self._reference_positions(points, boundary)
         else:
             points, w, ref = carried
         self.timer.lap("integration")
-        tree = cKDTree(self.x)
-        sf = shape_functions(self.x, points, tree=tree, reference=(self.X, ref, self.far), **self.rpim)
+        conf = build(self.x, boundary, points, w, self.lengths, quadrature=quad, reference=(self.X, ref, self.far))
         tr = self.traction
-        Nt = shape_functions(self.x, tr.positions(self.x), derivatives=False, tree=tree,
-                             reference=(self.X, tr.positions(self.X), self.far), **self.rpim).N
-        N_material = shape_functions(self.x, self.material_x, derivatives=False, tree=tree,
-                                     reference=(self.X, self.material_X, self.far), **self.rpim).N
+        Nt = conf.shape_functions_at(tr.positions(self.x), derivatives=False,
+                                     reference=(self.X, tr.positions(self.X), self.far)).N
+        N_material = conf.shape_functions_at(self.material_x, derivatives=False,
+                                             reference=(self.X, self.material_X, self.far)).N
         n_probe = len(self.material_X) - len(self.point_forces)
         F_points = assembly.load_vector(N_material[n_probe:], np.full(len(self.point_forces), self.thickness),
                                         self.point_forces[:, 0], self.point_forces[:, 1]) \
             if len(self.point_forces) else np.zeros(2 * len(self.x))
-        self.boundary, self.sf, self.N_material = boundary, sf, N_material
+        self.conf, self.N_material, self.points_X = conf, N_material, ref
         self.areas.append(area)
-        self.points, self.w, self.points_X = points, w, ref
-        self.G = gradient_operator(sf.dNdx, sf.dNdy)
-        self.GT = self.G.T
+        self._set_gradient()
         self.loads = BoundaryLoads(Nt, tr.weights, tr.tx, tr.ty, tr.turn_ends, tr.follower, tr.d0, F_points)
         self.timer.lap("shape_functions")
+
+    def _set_gradient(self) -> None:
+        """G of the current configuration and its transpose, kept across the Newton iterations."""
+        self.G = self.conf.block_gradient()
+        self.GT = self.G.T
+
+    @property
+    def boundary(self) -> Boundary:
+        return self.conf.boundary
+
+    @property
+    def points(self) -> np.ndarray:
+        """(m, 2) the integration points."""
+        return self.conf.points
+
+    @property
+    def w(self) -> np.ndarray:
+        """(m,) their weights (thickness included)."""
+        return self.conf.w
+
+    @property
+    def sf(self) -> ShapeFunctions:
+        return self.conf.sf
 
     # -- increments ----------------------------------------------------------------------------------
     def relative_gradient(self, du: np.ndarray) -> np.ndarray:
@@ -263,23 +277,13 @@ class AdaptiveBody:
                     self.nodal_state = project_to_nodes(self.sf.N, self.w, state)
                 self.timer.lap("transfer")
                 return None
-        self.points, self.state, self.w, self.strained = moved, state, w_moved, strained
-        self._map_gradients(f)
+        self.state, self.strained = state, strained
+        self.conf = self.conf.carried(self.x, moved, w_moved, f)
+        self._set_gradient()
         self.nodal_state = project_to_nodes(N_old, w_moved, state)
         self.skipped_rebuilds += skipped is not None
         self.timer.lap("transfer")
         return skipped
-
-    def _map_gradients(self, f: np.ndarray) -> None:
-        finv = inv2(f)
-        dx, dy = self.sf.dNdx, self.sf.dNdy
-        rows = np.repeat(np.arange(dx.shape[0]), np.diff(dx.indptr))
-        data_x = dx.data * finv[rows, 0, 0] + dy.data * finv[rows, 1, 0]
-        data_y = dx.data * finv[rows, 0, 1] + dy.data * finv[rows, 1, 1]
-        self.sf.dNdx = sp.csr_matrix((data_x, dx.indices, dx.indptr), shape=dx.shape)
-        self.sf.dNdy = sp.csr_matrix((data_y, dx.indices, dx.indptr), shape=dx.shape)
-        self.G = gradient_operator(self.sf.dNdx, self.sf.dNdy)
-        self.GT = self.G.T
 
     @property
     def u(self) -> np.ndarray:
@@ -289,32 +293,32 @@ class AdaptiveBody:
         return self.update.cauchy(self.nodal_state)
 
 
-def _traction_tags(conf, thickness: float) -> TractionTags:
-    q = conf.traction
-    nodes = conf.disc.nodes
+def _traction_tags(nodes: np.ndarray, tags: BoundaryTags, thickness: float) -> TractionTags:
+    q = tags.traction
     a, b = nodes[q.ends[:, 0]], nodes[q.ends[:, 1]]
     fraction = np.einsum("pd,pd->p", q.points - a, b - a) / np.einsum("pd,pd->p", b - a, b - a)
     turn = q.turn_ends
-    return TractionTags(q.ends, fraction, q.weights * thickness, conf.tx, conf.ty, q.follower, turn,
+    return TractionTags(q.ends, fraction, q.weights * thickness, tags.tx, tags.ty, q.follower, turn,
                         nodes[turn[:, 1]] - nodes[turn[:, 0]])
 
 
-def adaptive_body(case: Case, timer: Timer | None = None) -> tuple[AdaptiveBody, Configuration]:
-    """The case's node cloud as an :class:`AdaptiveBody` in its reference configuration, and the
-    reference configuration's tags (constrained dofs and the rest)."""
+def adaptive_body(case: Case, timer: Timer | None = None) -> tuple[AdaptiveBody, BoundaryTags]:
+    """The case's node cloud as an :class:`AdaptiveBody` in its reference configuration, and the tags
+    the problem's selectors put on the reference cloud (constrained dofs and the rest)."""
     problem = case.problem
     update = stress_update(case)
     if case.method.boundary != "alpha":
         raise ProblemError("the updated-Lagrangian solver integrates over the tracked boundary; "
                            "set method.boundary = \"alpha\"", key="method.boundary")
     timer = timer or Timer()
-    conf = build_configuration(case, timer)      # reference cloud, tags, and the checks of a linear run
+    cloud = reference_cloud(case, timer)         # with the checks of a linear run
+    tags = boundary_tags(case, cloud.nodes, cloud.boundary, cloud.lengths)
     probes_X = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
     loads_X = np.array([[p.x, p.y] for p in problem.point_loads]).reshape(-1, 2)
     forces = np.array([[p.fx, p.fy] for p in problem.point_loads]).reshape(-1, 2)
-    body = AdaptiveBody(case, conf.disc.nodes, conf.disc.d_c, update, _traction_tags(conf, problem.thickness),
+    body = AdaptiveBody(case, cloud.nodes, cloud.lengths, update, _traction_tags(cloud.nodes, tags, problem.thickness),
                         np.r_[probes_X, loads_X], forces, timer)
-    return body, conf
+    return body, tags
 
 
 def solve_updated_lagrangian(case: Case) -> Result:
@@ -326,11 +330,11 @@ def solve_updated_lagrangian(case: Case) -> Result:
         raise ProblemError("gravity is not in the large-deformation solvers yet (a Mohr-Coulomb or linear "
                            "analysis takes it)", key="problem.gravity")
     timer = Timer()
-    body, conf = adaptive_body(case, timer)
-    update, X, d_c = body.update, body.X, body.d_c
+    body, tags = adaptive_body(case, timer)
+    update, X = body.update, body.X
     probes_X = body.material_X[:len(problem.probes)]
     n = len(X)
-    fixed, fixed_values = conf.fixed, conf.fixed_values
+    fixed, fixed_values = tags.fixed, tags.fixed_values
     series: list[dict] = []
 
     def solve(K, residual):   # the rate-form and follower tangents are not symmetric
@@ -375,6 +379,6 @@ def solve_updated_lagrangian(case: Case) -> Result:
                                  if len(areas) > 1 else 0.0},
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},
         timings=timer.total(), history=history, series=series,
-        parameters={**case.resolved, "derived": {"d_c": d_c, "alpha": body.alpha,
-                                                 "support_radius": body.rpim["support_radius"]}},
+        parameters={**case.resolved, "derived": {"d_c": body.lengths.d_c, "alpha": body.lengths.alpha,
+                                                 "support_radius": body.lengths.support_radius}},
         defaults=case.defaults)

@@ -21,7 +21,8 @@ setting, fitted for the benchmark (study ``column_collapse_viscosity``). The per
 :mod:`ctmrpim.gradient_operator`.
 
 **Configuration.** Boundary (alpha shape), CTM points and RPIM shape functions are built on the node
-positions x_r of the last rebuild (a :class:`Frame`). Between rebuilds the points move with the body:
+positions x_r of the last rebuild (the frame, a
+:class:`~ctmrpim.discretisation.configuration.Configuration`). Between rebuilds the points move with the body:
 the deformation gradient relative to x_r is F = I + grad_r (x - x_r), and
 
     F_int = sum_p w_r,p P_p grad_r N,      P = det F sigma F^-T,
@@ -96,16 +97,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape
 from ctmrpim.discretisation.boundary_conditions import constrained_dofs
-from ctmrpim.discretisation.configuration import discretise
-from ctmrpim.discretisation.ctm import integration_points
-from ctmrpim.discretisation.gradient_operator import GradientOperator
+from ctmrpim.discretisation.configuration import Configuration, build, lay_points, reference_cloud
 from ctmrpim.discretisation.lumped_mass import lumped_mass
-from ctmrpim.discretisation.rpim import shape_functions
 from ctmrpim.discretisation.state_transfer import NodalProjection
 from ctmrpim.errors import ProblemError
 from ctmrpim.io.checkpoint import NAME as CHECKPOINT
@@ -157,40 +154,6 @@ class Diverged(ProblemError):
 
 
 @dataclass
-class Frame:
-    """Everything built on one configuration x of the nodes: boundary, CTM points and weights (thickness
-    included), RPIM values ``N`` at the points and their gradients ``grad`` (compiled products,
-    :mod:`ctmrpim.gradient_operator`)."""
-
-    x: np.ndarray
-    boundary: Boundary
-    points: np.ndarray
-    w: np.ndarray
-    N: sp.csr_matrix
-    grad: GradientOperator
-    active: np.ndarray       # nodes of the body (the RPIM cloud); the others are free particles
-
-    @property
-    def free(self) -> np.ndarray:
-        """(n,) bool: the free particles."""
-        out = np.ones(len(self.x), bool)
-        out[self.active] = False
-        return out
-
-    def moved_points(self, x: np.ndarray) -> np.ndarray:
-        """(m, 2) where the points are when the nodes have moved from the frame's positions to ``x``."""
-        return self.points + np.asarray(self.N @ (x - self.x))
-
-    def gradient(self, d: np.ndarray) -> np.ndarray:
-        """(m, 4) F = I + grad d (xx, xy, yx, yy) of nodal displacements d (n, 2) relative to x."""
-        return self.grad.gradient(d)
-
-    def force(self, P: np.ndarray) -> np.ndarray:
-        """(n, 2) sum_p w_p P_p grad N of first Piola stresses P (m, 4: xX, xY, yX, yY) relative to x."""
-        return self.grad.force(P * self.w[:, None])
-
-
-@dataclass
 class Energy:
     """Energy accounts of the dynamic stage (J per unit thickness times the thickness)."""
 
@@ -208,7 +171,7 @@ class ExplicitRun:
     """One explicit run of a Case, writing its series and checkpoints into ``out``."""
 
     def __init__(self, case: Case, out: Path, key: str):
-        problem, method = case.problem, case.method
+        problem = case.problem
         if not isinstance(problem.material, MohrCoulomb):
             raise ProblemError("explicit dynamics is implemented for model = \"mohr-coulomb\"", key="material.model")
         if case.method.boundary != "alpha":
@@ -218,18 +181,15 @@ class ExplicitRun:
         self.settings: Explicit = case.explicit
         self.material = problem.material
         self.timer = Timer()
-        disc = discretise(case, self.timer)
-        self.X, self.d_c = disc.nodes, disc.d_c
+        cloud = reference_cloud(case, self.timer)
+        self.X, self.lengths = cloud.nodes, cloud.lengths
+        self.d_c = cloud.d_c
         n = len(self.X)
-        self.alpha = method.alpha * self.d_c
-        self.r_x, self.r_y = (s * self.d_c for s in method.line_spacing)
-        self.rpim = dict(support_radius=method.support_radius * self.d_c, eta=method.eta,
-                         polynomial_terms=method.polynomial_terms, scale=self.d_c)
         self.thickness = problem.thickness
-        self.mass = lumped_mass(self.X, disc.boundary.triangles, self.material.density, self.thickness)
+        self.mass = lumped_mass(self.X, cloud.boundary.triangles, self.material.density, self.thickness)
         self.weight = self.mass[:, None] * np.asarray(problem.gravity, float)[None, :]
-        boundary_nodes = np.unique(np.concatenate(disc.boundary.loops))
-        tol = method.match_tolerance * self.d_c
+        boundary_nodes = np.unique(np.concatenate(cloud.boundary.loops))
+        tol = self.lengths.match_tolerance
         self.movable = np.ones((n, 2), bool)
         if problem.constraints:
             dofs, values = constrained_dofs(problem, self.X, boundary_nodes, tol)
@@ -251,14 +211,14 @@ class ExplicitRun:
         self.timer.lap("set_up")
 
     # -- configuration -------------------------------------------------------------------------------
-    def lay_frame(self, x: np.ndarray, free: np.ndarray) -> Frame:
+    def lay_frame(self, x: np.ndarray, free: np.ndarray) -> Configuration:
         """Boundary and new CTM points on positions x of the body's nodes (``free`` marks the others), and
         RPIM there. A node outside the alpha shape has left the body: with ``detached = "stop"`` the run
         stops naming it; with ``"free"`` it becomes a free particle for good (gravity and the walls move
         it, it keeps its mass, no stress): a grain that left the flow does not rejoin it, so it can never
         land on top of a node of the body (two nodes at one place make the RPIM moment matrix singular)."""
         body = np.flatnonzero(~free)
-        sub = alpha_shape(x[body], self.alpha, self.d_c)
+        sub = alpha_shape(x[body], self.lengths.alpha, self.d_c)
         detached = body[sub.detached]
         if len(detached) and self.settings.detached == "stop":
             i = int(detached[0])
@@ -268,32 +228,27 @@ class ExplicitRun:
         free = free.copy()
         free[detached] = True
         loops = [body[lp] for lp in sub.loops]
-        quad = integration_points([x[lp] for lp in loops], self.r_x, self.r_y, self.case.method.gauss_points,
-                                  mode="uniform")
-        return self.frame_at(x, free, quad.points, quad.weights * self.thickness, loops)
+        quad, w = lay_points([x[lp] for lp in loops], self.lengths, self.thickness)
+        return self.frame_at(x, free, quad.points, w, loops)
 
     def frame_at(self, x: np.ndarray, free: np.ndarray, points: np.ndarray, w: np.ndarray,
-                 loops: list[np.ndarray]) -> Frame:
+                 loops: list[np.ndarray]) -> Configuration:
         """RPIM of the body's nodes at positions x (``free`` marks the others) at ``points`` with weights
         ``w``; ``loops`` the boundary (node indices). A point whose moment matrix is singular, or whose
         shape-function gradients exceed GRADIENT_LIMIT / d_c (it extrapolates from a support on one side,
         where the nodes around it have left the body), gets weight 0: it integrates nothing (counted)."""
-        active = np.flatnonzero(~free)
-        sf = shape_functions(x[active], points, tree=cKDTree(x[active]), min_nodes=self.case.method.min_support,
-                             drop_singular=True, **self.rpim)
-        shape = (len(points), len(x))
-        N, dx, dy = (sp.csr_matrix((M.data, active[M.indices], M.indptr), shape=shape)
-                     for M in (sf.N, sf.dNdx, sf.dNdy))
+        boundary = Boundary(points=x, loops=loops, triangles=np.zeros((0, 3), int), detached=np.flatnonzero(free))
+        frame = build(x.copy(), boundary, points.copy(), w.copy(), self.lengths, active=np.flatnonzero(~free),
+                      min_nodes=self.case.method.min_support, drop_singular=True)
+        dx, dy = frame.sf.dNdx, frame.sf.dNdy
         size = np.sqrt(np.asarray(dx.multiply(dx).max(axis=1).todense()).ravel()
                        + np.asarray(dy.multiply(dy).max(axis=1).todense()).ravel()) * self.d_c
-        dropped = np.union1d(sf.dropped, np.flatnonzero(size > GRADIENT_LIMIT))
-        w = w.copy()
-        w[dropped] = 0.0
+        dropped = np.union1d(frame.sf.dropped, np.flatnonzero(size > GRADIENT_LIMIT))
+        frame.w[dropped] = 0.0
         self.dropped_points += len(dropped)
-        boundary = Boundary(points=x, loops=loops, triangles=np.zeros((0, 3), int), detached=np.flatnonzero(free))
-        return Frame(x.copy(), boundary, points.copy(), w, N, GradientOperator(dx, dy), active)
+        return frame
 
-    def _stiffness(self, frame: Frame):
+    def _stiffness(self, frame: Configuration):
         """d (n, 2) -> elastic small-strain force K d on the frame (for the time step)."""
         def apply(d: np.ndarray) -> np.ndarray:
             L = frame.gradient(d)
@@ -621,7 +576,7 @@ class ExplicitRun:
     # -- result ----------------------------------------------------------------------------------------
     def result(self) -> Result:
         fields = self.nodal_fields()
-        final = alpha_shape(self.x, self.alpha, self.d_c)      # the boundary of the final configuration
+        final = alpha_shape(self.x, self.lengths.alpha, self.d_c)      # the boundary of the final configuration
         e = self.energy
         ke, elastic = self.kinetic_energy(), self.elastic_energy()
         released = e.gravity
@@ -661,8 +616,8 @@ class ExplicitRun:
                                                    "boundary_loops": len(final.loops)},
             timings=timings, history=self.history,
             fields={"velocity": fields["velocity"], "plastic_strain": fields["plastic_strain"]},
-            parameters={**self.case.resolved, "derived": {"d_c": self.d_c, "alpha": self.alpha,
-                                                          "support_radius": self.rpim["support_radius"]}},
+            parameters={**self.case.resolved, "derived": {"d_c": self.d_c, "alpha": self.lengths.alpha,
+                                                          "support_radius": self.lengths.support_radius}},
             defaults=self.case.defaults, outcome={"dynamics": dynamics})
 
 
@@ -675,7 +630,7 @@ def _compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
                      a[:, 2] * b[:, 0] + a[:, 3] * b[:, 2], a[:, 2] * b[:, 1] + a[:, 3] * b[:, 3]], axis=1)
 
 
-def _project(frame: Frame, w: np.ndarray, values: np.ndarray) -> np.ndarray:
+def _project(frame: Configuration, w: np.ndarray, values: np.ndarray) -> np.ndarray:
     """Nodal values (n, k) of point values (m, k): the L2 projection over the body nodes that some point
     of positive weight supports; the others (free particles, nodes left beside the dropped points of a
     thinned front, where the stress is about zero) get zero."""
