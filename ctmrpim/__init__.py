@@ -13,10 +13,10 @@ Subpackages: :mod:`ctmrpim.problem` (the continuous problem and its input), :mod
 
 from ctmrpim.cases import load_case
 from ctmrpim.errors import ProblemError
-from ctmrpim.methods import register, solve
+from ctmrpim.methods import SolutionMethod, register, solve
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.model import Problem
 from ctmrpim.result import Result
 from ctmrpim.version import __version__
 
-__all__ = ["Case", "Problem", "ProblemError", "Result", "__version__", "load_case", "register", "solve"]
+__all__ = ["Case", "Problem", "ProblemError", "Result", "SolutionMethod", "__version__", "load_case", "register", "solve"]

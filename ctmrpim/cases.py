@@ -5,10 +5,10 @@ import difflib
 from pathlib import Path
 from typing import Iterable
 
-from ctmrpim import benchmarks
+import ctmrpim.benchmarks as benchmarks
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
-from ctmrpim.problem.problem_file import read_case
+from ctmrpim.problem.reader import read_case
 
 
 def load_case(target: str | Path, overrides: Iterable[str] = ()) -> Case:

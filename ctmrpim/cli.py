@@ -16,7 +16,8 @@ import warnings
 from importlib.metadata import entry_points
 from pathlib import Path
 
-from ctmrpim import benchmarks, methods
+import ctmrpim.benchmarks as benchmarks
+import ctmrpim.methods as methods
 from ctmrpim.cases import load_case
 from ctmrpim.errors import ProblemError
 from ctmrpim.io.run_folder import write_outputs
@@ -30,7 +31,7 @@ COMMANDS = "ctmrpim.commands"
 def describe(result: Result, case: Case) -> str:
     c, t = result.counts, result.timings
     head = f"{case.problem.name} ({result.method}): {c.get('nodes')} nodes"
-    d_c = result.parameters.get("derived", {}).get("d_c") or result.parameters.get("d_c")
+    d_c = result.parameters.get("derived", {}).get("d_c")
     if d_c:
         head += f", d_c = {d_c:.4g}"
     head += f", {c.get('integration_points')} integration points"

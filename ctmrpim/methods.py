@@ -1,11 +1,12 @@
 """The methods that solve a :class:`~ctmrpim.problem.case.Case`, found by name.
 
-Every method registers a solve function here with :func:`register`: CTM-RPIM (``"ctm-rpim"``,
-:func:`ctmrpim.solvers.meshfree.solve_meshfree`, registered on first use) and any finite-element reference, which lives in its own package and
-is announced by an entry point of the group ``ctmrpim.methods`` in its distribution's metadata (the
-scikit-fem reference: ``fem = "reference_fem.method"``). Loading the entry point imports the module,
-which registers itself; the core never imports a reference, so a reference can import the core freely.
-:func:`solve` looks the method up and calls it: no chain of ``if``s over method names.
+A method is a :class:`SolutionMethod` (a name, a solve function, its element types). Methods are
+announced by entry points of the group ``ctmrpim.methods`` in their distributions' metadata
+(``pyproject.toml``): CTM-RPIM by this package (``ctm-rpim =
+"ctmrpim.solvers.meshfree:METHOD"``), the scikit-fem reference by its own (``fem =
+"reference_fem.method:METHOD"``); :func:`register` adds one at run time. A method is imported on first
+use, so the registry imports no solver and a reference can import the core freely. :func:`solve` looks
+the method up and calls it: no chain of ``if``s over method names.
 """
 from __future__ import annotations
 
@@ -39,27 +40,24 @@ class SolutionMethod:
 _REGISTRY: dict[str, SolutionMethod] = {}
 
 
-def register(name: str, solve: Callable[[Case, str | None, RunOptions], Result], elements: tuple[str, ...] = (),
-             description: str = "") -> None:
-    """Make ``solve`` available as method ``name`` (registering a name again replaces it)."""
-    _REGISTRY[name] = SolutionMethod(name, solve, tuple(elements), description)
+def register(method: SolutionMethod) -> None:
+    """Make ``method`` available under its name (registering a name again replaces it)."""
+    _REGISTRY[method.name] = method
 
 
 def names() -> list[str]:
-    """Every method that can be asked for: registered, this package's, and announced by entry points."""
-    return sorted({DEFAULT, *_REGISTRY, *(ep.name for ep in entry_points(group=GROUP))})
+    """Every method that can be asked for: registered, or announced by an entry point."""
+    return sorted({*_REGISTRY, *(ep.name for ep in entry_points(group=GROUP))})
 
 
 def get(name: str) -> SolutionMethod:
     """The method called ``name``, imported on first use; a ProblemError for an unknown name."""
     if name not in _REGISTRY:
-        if name == DEFAULT:
-            from ctmrpim.solvers.meshfree import solve_meshfree
-            register(DEFAULT, solve_meshfree, description="adaptive CTM-RPIM (CTM integration, RPIM shape "
-                                                          "functions, alpha-shape boundary)")
-        else:
-            for ep in entry_points(group=GROUP, name=name):
-                ep.load()
+        for ep in entry_points(group=GROUP, name=name):
+            method = ep.load()
+            if not (isinstance(method, SolutionMethod) and method.name == name):
+                raise TypeError(f"entry point {ep.value!r} of {GROUP} is not the SolutionMethod {name!r}")
+            register(method)
     if name not in _REGISTRY:
         raise ProblemError(f"unknown method {name!r}; available: {', '.join(names())}", key="--solver")
     return _REGISTRY[name]

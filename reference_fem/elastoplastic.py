@@ -1,4 +1,4 @@
-"""scikit-fem reference for the Mohr-Coulomb analyses: the same :class:`ctmrpim.elastoplastic.PlasticSystem`
+"""scikit-fem reference for the Mohr-Coulomb analyses: the same :class:`ctmrpim.solvers.plastic_system.PlasticSystem`
 (one material class, one return mapping, one iteration, one strength-reduction driver) on a finite
 element discretisation of the same Problem.
 
@@ -50,7 +50,7 @@ def gradient_operator(basis: Basis) -> sp.csr_matrix:
 
 def solve_fem_elastoplastic(case: Case, element: str = "p2",
                             progress: Callable[[Any], None] = lambda level: None) -> Result:
-    """:func:`ctmrpim.elastoplastic.run_elastoplastic` with the finite element ``element``."""
+    """:func:`ctmrpim.solvers.plastic_system.run_elastoplastic` with the finite element ``element``."""
     problem = case.problem
     if not isinstance(problem.material, MohrCoulomb):
         raise ProblemError("the elastoplastic FEM reference needs model = \"mohr-coulomb\"", key="material.model")
@@ -113,8 +113,8 @@ def solve_fem_elastoplastic(case: Case, element: str = "p2",
         probe_values=probe_values, peak_traction=_peak_traction(problem, fm, vec, tol),
         counts={"nodes": int(mesh.nvertices), "dofs": int(basis.N), "elements": int(mesh.nelements),
                 "integration_points": len(w)},
-        parameters={**case.resolved, "d_c": fm.d_c, "element": element,
-                    "derived": {"G": material.G, "K": material.K}})
+        parameters={**case.resolved, "derived": {"d_c": fm.d_c, "element": element, "G": material.G,
+                                                 "K": material.K}})
     return run_elastoplastic(case, system, out, timer, progress)
 
 

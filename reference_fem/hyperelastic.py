@@ -1,15 +1,15 @@
 """scikit-fem reference for quasi-static hyperelastic problems: total-Lagrangian Newton with load stepping.
 
-The finite element counterpart of :func:`ctmrpim.total_lagrangian.solve_total_lagrangian`: the same
+The finite element counterpart of :func:`ctmrpim.solvers.total_lagrangian.solve_total_lagrangian`: the same
 Case (neo-Hookean material in plane strain, dead tractions and pressures on the reference boundary,
 follower tractions turning with their segment or with their whole face, prescribed displacements
 scaled by the load factor) on a mesh of the same field nodes, optionally
 refined ``refine`` times for a much finer reference. Loads are stepped by the same driver as the
-meshfree solver (:func:`ctmrpim.load_stepping.step_loads`: Newton-Raphson, reported cut-backs).
+meshfree solver (:func:`ctmrpim.solvers.load_stepping.step_loads`: Newton-Raphson, reported cut-backs).
 
     f_int = t * int P_iJ(F) dv_i/dX_J dX,        K = t * int dv_i/dX_J A_iJkL(F) ddu_k/dX_L dX,
 
-with F = I + grad u, and P, A = dP/dF from :meth:`ctmrpim.hyperelastic.NeoHookean.stress_tangent`
+with F = I + grad u, and P, A = dP/dF from :meth:`ctmrpim.materials.neo_hookean.NeoHookean.stress_tangent`
 evaluated at the quadrature points. The Cauchy stress P F^T / J is L2-projected onto the scalar space
 for the nodal and probe values.
 """
@@ -275,6 +275,6 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
                 "cutbacks": path.cutbacks},
         timings={"mesh": t1 - t0, "solve": t2 - t1, "postprocess": t3 - t2, "total": t3 - t0},
         history=history, series=series,
-        parameters={**case.resolved, "d_c": fm.d_c, "element": element, "refine": refine,
-                    "derived": {"mu": material.mu, "lambda": material.lam}},
+        parameters={**case.resolved, "derived": {"d_c": fm.d_c, "element": element, "refine": refine,
+                                                 "mu": material.mu, "lambda": material.lam}},
         defaults=list(case.defaults))

@@ -2,7 +2,7 @@
 
 On a rectangle with ``nodes.grid`` the tensor grid is meshed directly (quads, or each quad split
 into two triangles); any other node cloud is Delaunay-triangulated and trimmed to the geometry.
-Vertices keep the order of :func:`ctmrpim.nodes.make_nodes`, so nodal results line up one to one
+Vertices keep the order of :func:`ctmrpim.problem.node_cloud.make_nodes`, so nodal results line up one to one
 with the meshfree solver's (except for nodes of a cloud that no kept triangle uses, which are dropped).
 """
 from __future__ import annotations

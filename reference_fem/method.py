@@ -1,10 +1,10 @@
-"""The scikit-fem reference as the method ``"fem"`` of :mod:`ctmrpim.methods` (entry point
-``ctmrpim.methods: fem``): each analysis of a Case to its finite-element solver."""
+"""The scikit-fem reference as the method ``"fem"`` of :mod:`ctmrpim.methods` (``METHOD``, the entry
+point ``ctmrpim.methods: fem``): each analysis of a Case to its finite-element solver."""
 from __future__ import annotations
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
-from ctmrpim.methods import register
+from ctmrpim.methods import SolutionMethod
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result
 from ctmrpim.run_options import RunOptions
@@ -30,4 +30,4 @@ def solve_fem_case(case: Case, element: str | None, options: RunOptions) -> Resu
     return solve_fem(case, element)
 
 
-register("fem", solve_fem_case, ELEMENTS, description="scikit-fem reference on the same nodes (Q1, P1, P2)")
+METHOD = SolutionMethod("fem", solve_fem_case, ELEMENTS, description="scikit-fem reference on the same nodes (Q1, P1, P2)")

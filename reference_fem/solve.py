@@ -1,4 +1,4 @@
-"""scikit-fem reference solution of a :class:`ctmrpim.problem.Problem` (linear elastostatics).
+"""scikit-fem reference solution of a :class:`ctmrpim.problem.model.Problem` (linear elastostatics).
 
 The same Case (problem, node set, match tolerance) the CTM-RPIM solver reads is meshed on the same
 nodes and solved with Q1, P1 or P2 elements; the answer is a :class:`ctmrpim.result.Result` of the
@@ -106,7 +106,7 @@ def solve_fem(case: Case, element: str = "q1") -> Result:
                 "integration_points": int(np.asarray(basis.dx).size)},
         timings={"mesh": t1 - t0, "assembly": t2 - t1, "solve": t3 - t2, "postprocess": t4 - t3,
                  "total": t4 - t0},
-        parameters={**case.resolved, "d_c": fm.d_c, "element": element},
+        parameters={**case.resolved, "derived": {"d_c": fm.d_c, "element": element}},
         defaults=list(case.defaults))
 
 

@@ -38,7 +38,7 @@ def metrics(outcome: CaseOutcome, extra=None) -> dict[str, Any]:
     tip = errors.get("probes", {}).get("tip", {})
     derived = s["parameters"].get("derived", {})
     row.update(nodes=s["counts"]["nodes"], integration_points=s["counts"]["integration_points"],
-               d_c=derived.get("d_c", s["parameters"].get("d_c")),
+               d_c=derived.get("d_c"),
                tip_error=tip.get("uy"), l2_error=errors.get("l2"), energy_error=errors.get("energy"),
                time_s=s["timings"]["total"])
     if extra is not None:

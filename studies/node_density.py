@@ -2,8 +2,9 @@
 CTM-RPIM with linear and quadratic augmentation against scikit-fem Q1, P1 and P2 on the same node
 grids: tip, L2 and energy-norm errors, integration points, wall time, fitted rates in h.
 
-CTM-RPIM uses DESIGN.md's defaults (eta = 5, r_c = 4 d_c, r_x = r_y = d_c/3, one Gauss point), not
-the r_c = 2 d_c / two-point setting printed beside Fig. 9 (1-1.8 % at 33 x 9, not the 0.3 % shown).
+CTM-RPIM uses the project's defaults (eta = 5, r_c = 4 d_c, r_x = r_y = d_c/3, one Gauss point; docs/design.md,
+'Parameters and conventions'), not the r_c = 2 d_c / two-point setting printed beside Fig. 9 (1-1.8 % at
+33 x 9, not the 0.3 % shown).
 """
 from __future__ import annotations
 

@@ -3,7 +3,7 @@ the two candidate geometries of Fig. 18 - `slope` (Smith & Griffiths 6.4 embankm
 (Griffiths & Lane 1999, Example 1) - as a bracket [last stable SRF, first failed SRF], CTM-RPIM and
 scikit-fem P2 on the same nodes with the same PlasticSystem, return mapping and search (bracket by
 0.1 from SRF = 1 continuing from the last stable state, then bisection to 0.01; failure = non-convergence
-of the equilibrium iteration, see ctmrpim.strength_reduction), against Bishop's simplified method computed by us
+of the equilibrium iteration, see ctmrpim.solvers.strength_reduction), against Bishop's simplified method computed by us
 for each geometry (critical circle searched). The paper reports 1.3-1.4; Griffiths & Lane's
 finite elements 1.4. Node spacing h: the default clouds (0.58 m for `slope`, 1928 nodes, the paper's
 about 1881; 0.35 m for `slope-gl`, 1926 nodes) in the full run, beside coarser ones (1.0 m and 0.6 m,

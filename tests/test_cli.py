@@ -150,7 +150,7 @@ def test_fem_q1(tmp_path: Path, run) -> None:
     assert proc.stdout.startswith("cantilever (fem-q1): 297 nodes")
     assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["result.vtu", "summary.json"]
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
-    assert s["method"] == "fem-q1" and s["parameters"]["element"] == "q1"
+    assert s["method"] == "fem-q1" and s["parameters"]["derived"]["element"] == "q1"
     assert set(s["probes"]["tip"]) == {"x", "y", "ux", "uy", "sxx", "syy", "sxy"}
     assert tolerances.passes("cantilever-fem-q1-33x9-tip", s["errors"]["probes"]["tip"]["uy"])
     mesh = meshio.read(tmp_path / "o" / "result.vtu")

@@ -68,7 +68,7 @@ def test_fem_p2_end_moment_with_face_followers() -> None:
 def test_follower_values(value, ok: bool) -> None:
     import tomllib
 
-    from ctmrpim.problem.problem_file import parse_case
+    from ctmrpim.problem.reader import parse_case
 
     raw = tomllib.loads(benchmarks.path("end-moment").read_text())
     raw["traction"][0]["follower"] = value

@@ -33,7 +33,8 @@ from ctmrpim.materials.objective_stress import (
 )
 from ctmrpim.problem.model import Wall
 from ctmrpim.solvers.explicit.contact import enforce_walls
-from ctmrpim.solvers.explicit.run import ExplicitRun, input_key, solve_explicit
+from ctmrpim.solvers.explicit.run import ExplicitRun, solve_explicit
+from ctmrpim.solvers.explicit.state import input_key
 
 QUICK = ["nodes.grid=[16, 9]", "method.alpha=2.0"]
 
@@ -312,7 +313,7 @@ def test_walls_need_explicit_dynamics(tmp_path):
     text = text.replace('model = "mohr-coulomb"', 'model = "linear-elastic"')
     f = tmp_path / "p.toml"
     f.write_text(text)
-    from ctmrpim.problem.problem_file import read_case
+    from ctmrpim.problem.reader import read_case
     with pytest.raises(ProblemError, match="explicit"):
         read_case(f)
 

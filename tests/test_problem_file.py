@@ -13,7 +13,7 @@ from ctmrpim import benchmarks
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.geometry import CIRCLE_SAGITTA, Geometry, Shape, circle_segments
 from ctmrpim.problem.node_cloud import NodeSpec, check_nodes_inside, make_nodes
-from ctmrpim.problem.problem_file import apply_overrides, read_case
+from ctmrpim.problem.reader import apply_overrides, read_case
 from ctmrpim.problem.settings import Method
 
 MINIMAL = """

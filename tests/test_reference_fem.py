@@ -58,7 +58,7 @@ def test_result_shape_matches_meshfree_nodes(solved) -> None:
     kind, cells = res.cells[0]
     assert kind == "quad" and cells.shape == (32 * 8, 4)
     assert res.counts == {"nodes": 297, "dofs": 594, "elements": 256, "integration_points": 1024}
-    assert res.method == "fem-q1" and res.parameters["element"] == "q1"
+    assert res.method == "fem-q1" and res.parameters["derived"]["element"] == "q1"
     assert set(res.timings) == {"mesh", "assembly", "solve", "postprocess", "total"}
     # the constrained end carries the exact displacement
     exact = case.problem.exact

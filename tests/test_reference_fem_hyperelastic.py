@@ -63,7 +63,7 @@ def test_result_shape_and_history(p2, p2_fine) -> None:
     assert p2.method == "fem-p2-tl"
     assert p2.points.shape == (306, 2) and p2.u.shape == (306, 2) and p2.stress.shape == (306, 3)
     assert p2.cells[0][0] == "triangle" and p2.cells[0][1].shape == (500, 3)
-    assert p2_fine.points.shape == (1111, 2) and p2_fine.parameters["refine"] == 1
+    assert p2_fine.points.shape == (1111, 2) and p2_fine.parameters["derived"]["refine"] == 1
     assert np.array_equal(p2_fine.points[:306], p2.points)     # refinement keeps the grid's vertices first
     assert p2.counts["load_increments"] == 4 and p2.counts["cutbacks"] == 0
     h = p2.history

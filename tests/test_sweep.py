@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -21,6 +22,31 @@ def test_hash_follows_the_resolved_input() -> None:
     assert a == case_hash(CaseSpec("cantilever", ("nodes.grid=[33, 9]",)))   # the default, spelt out
     assert a != case_hash(CaseSpec("cantilever", ("method.eta=5.5",)))
     assert a != case_hash(CaseSpec("cantilever", (), "fem", "q1"))
+
+
+def test_cache_key_hashes_only_the_code_that_computes_results(tmp_path) -> None:
+    """Editing the command line's help, a study or the report's prose invalidates no cached case and no
+    checkpoint: the key hashes the core without ``cli.py`` (and the method's own package), never
+    ``studies/``; editing a solver module does change it."""
+    import shutil
+
+    import reference_fem
+    from ctmrpim.io.provenance import PACKAGE, PRESENTATION, hashed_files, source_hash
+    from studies.sweep import method_version
+
+    hashed = hashed_files(PACKAGE, PRESENTATION)
+    assert hashed and all(PACKAGE in f.parents for f in hashed)
+    assert PACKAGE / "cli.py" not in hashed and PACKAGE / "discretisation" / "rpim.py" in hashed
+    copy = tmp_path / "ctmrpim"
+    shutil.copytree(PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    before = source_hash(copy, PRESENTATION)
+    (copy / "cli.py").write_text((copy / "cli.py").read_text().replace("list the benchmark problems", "list them"))
+    assert source_hash(copy, PRESENTATION) == before
+    (copy / "discretisation" / "rpim.py").write_text((copy / "discretisation" / "rpim.py").read_text() + "\n# edited\n")
+    assert source_hash(copy, PRESENTATION) != before
+    # the finite-element method's version adds reference_fem's sources, and nothing of studies/
+    assert method_version("fem").startswith(method_version("ctm-rpim") + "+reference_fem-")
+    assert method_version("fem").endswith(source_hash(Path(reference_fem.__file__).parent)[:16])
 
 
 def test_resume_computes_only_what_is_missing(tmp_path) -> None:

@@ -95,7 +95,7 @@ def test_displacement_driven_loading_converges(solver: str, element: str) -> Non
 
     import numpy as np
 
-    from ctmrpim.problem.problem_file import parse_case
+    from ctmrpim.problem.reader import parse_case
 
     raw = tomllib.loads(benchmarks.path("tip-load").read_text())
     raw["constraint"].append({"where": "x == L", "uy": "-2.0"})

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
-from ctmrpim.problem.problem_file import read_case
+from ctmrpim.problem.reader import read_case
 
 FOLDER = Path(__file__).parent
 

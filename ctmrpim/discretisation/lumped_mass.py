@@ -1,10 +1,10 @@
 """Lumped nodal mass of the explicit dynamic solver (Eq. 9, "the lumped matrix is used").
 
-Row-sum lumping of the RPIM consistent mass goes negative (RPIM shape functions are not positive),
-so the mass is lumped geometrically (DESIGN.md): each node carries density x thickness x one third of
-the area of the alpha-shape triangles it is a vertex of, on the initial cloud. Every node of the body
-gets a positive mass, the masses sum to density x thickness x the tracked area, and they never change
-afterwards (mass is conserved exactly; a node keeps its mass wherever it goes).
+Row-sum lumping of the RPIM consistent mass goes negative (RPIM shape functions are not positive), so the
+mass is lumped geometrically (docs/design.md, 'Explicit dynamics'): each node carries density x thickness
+x one third of the area of the alpha-shape triangles it is a vertex of, on the initial cloud. Every node
+of the body gets a positive mass, the masses sum to density x thickness x the tracked area, and they
+never change afterwards (mass is conserved exactly; a node keeps its mass wherever it goes).
 """
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""State transfer across a rebuild of the integration points (DESIGN.md "State under re-tracking").
+"""State transfer across a rebuild of the integration points (docs/design.md, 'State under
+re-tracking').
 
 History lives at the CTM integration points. When the configuration is rebuilt (new boundary, new
 CTM points) each state component s is L2-projected onto the nodal RPIM space over the old points,

@@ -1,11 +1,11 @@
 """Checkpoints of long explicit runs: everything the next step needs, in float64, in one ``.npz``.
 
-A run resumed from a checkpoint ends in the same state as an uninterrupted run (DESIGN.md): the file
-holds the node positions and velocities, the state at the integration points, the positions the
-current configuration was built on (it is rebuilt from them, bit for bit, on resume), the time step,
-counters, energy accounts and history, and the hash of the resolved input and of the code, so that a
-checkpoint is never resumed with another problem or another solver. It is written atomically: a kill
-during the write leaves the previous checkpoint in place.
+A run resumed from a checkpoint ends in the same state as an uninterrupted run (docs/design.md, 'Explicit
+dynamics'): the file holds the node positions and velocities, the state at the integration points, the
+positions the current configuration was built on (it is rebuilt from them, bit for bit, on resume), the
+time step, counters, energy accounts and history, and the hash of the resolved input and of the code, so
+that a checkpoint is never resumed with another problem or another solver. It is written atomically: a
+kill during the write leaves the previous checkpoint in place.
 """
 from __future__ import annotations
 

@@ -37,8 +37,8 @@ def write_vtu(result: Result, out_dir: Path) -> Path:
 
 def write_series(result: Result, out_dir: Path) -> list[Path]:
     """One VTU per converged load increment on the *current* configuration (nodes moved by u, with
-    the boundary tracked on it where the solver re-tracks, else the reference one moved), and ``result.pvd``, the index ParaView opens as a time series (meshio has
-    no PVD writer; DESIGN.md prefers this to XDMF for clouds whose boundary changes). The index is
+    the boundary tracked on it where the solver re-tracks, else the reference one moved), and
+    ``result.pvd``, the index ParaView opens as a time series (docs/design.md, 'Output'). The index is
     written last, so a series is only announced once all its files exist."""
     if not result.series:
         return []

@@ -1,4 +1,4 @@
-"""Mohr-Coulomb elastic-perfectly plastic material, plane strain, non-associated (issue 5; DESIGN.md).
+"""Mohr-Coulomb elastic-perfectly plastic material, plane strain, non-associated (docs/design.md, 'Materials').
 
 Yield and plastic potential in principal stresses s1 >= s2 >= s3 (tension positive), sigma_zz carried
 as one of the three and sorted with the in-plane two every time:

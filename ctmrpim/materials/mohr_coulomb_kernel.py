@@ -1,11 +1,11 @@
 """The explicit solver's per-point stress update, compiled (numba): one pass over the integration points.
 
-Each step of :mod:`ctmrpim.explicit_dynamics` updates every integration point (about 10000 for the
+Each step of :mod:`ctmrpim.solvers.explicit` updates every integration point (about 10000 for the
 1071-node column): the Hughes-Winget strain increment and rotation of the relative deformation
-gradient f (:func:`ctmrpim.objective_stress.hughes_winget_c`), the rotation of the stress and plastic
-strain (:func:`ctmrpim.objective_stress.rotate_c`), the Mohr-Coulomb return of de Souza Neto et al.
-(2008), Box 8.4 (:meth:`ctmrpim.mohr_coulomb.MohrCoulomb.update`, without a tension cut-off), the
-plastic strain increment (:func:`ctmrpim.mohr_coulomb.plastic_strain_increment`) and the plastic
+gradient f (:func:`ctmrpim.materials.objective_stress.hughes_winget_c`), the rotation of the stress and plastic
+strain (:func:`ctmrpim.materials.objective_stress.rotate_c`), the Mohr-Coulomb return of de Souza Neto et al.
+(2008), Box 8.4 (:meth:`ctmrpim.materials.mohr_coulomb.MohrCoulomb.update`, without a tension cut-off), the
+plastic strain increment (:func:`ctmrpim.materials.mohr_coulomb.plastic_strain_increment`) and the plastic
 dissipation. Written with numpy arrays of 10000 these are about 150 passes over memory, each a
 temporary array; here they are one loop per point in registers. Measured in one script on 10000 points
 (Mohr-Coulomb states, 11 % of them yielding): 0.75 ms per step against 4.1 ms for the numpy forms.
@@ -42,7 +42,7 @@ class PointUpdate(NamedTuple):
 @njit(cache=True)
 def _sorted_principal(sxx, syy, sxy, szz):
     """Sorted principal stresses s1 >= s2 >= s3, the in-plane unit eigenvector of the larger in-plane
-    value and the slot of szz: :func:`ctmrpim.mohr_coulomb._principal` for one real stress."""
+    value and the slot of szz: :func:`ctmrpim.materials.mohr_coulomb._principal` for one real stress."""
     centre = 0.5 * (sxx + syy)
     half = 0.5 * (sxx - syy)
     gap = abs(half) + abs(sxy)
@@ -164,7 +164,7 @@ def point_update(material: MohrCoulomb, f: np.ndarray, stress: np.ndarray, plast
                  beta_dt: float = 0.0) -> PointUpdate:
     """One step at every point: from the relative deformation gradients ``f`` (m, 4: xx, xy, yx, yy) and
     the Cauchy stress and plastic strain (m, 4: xx, yy, xy, zz) of the last step to the new ones, the
-    return region of each point (:data:`ctmrpim.mohr_coulomb.ELASTIC`, ...) and the plastic dissipation
+    return region of each point (:data:`ctmrpim.materials.mohr_coulomb.ELASTIC`, ...) and the plastic dissipation
     sum_p w_p (sigma_rotated + sigma_new) / 2 : d eps_p. With ``beta_dt`` = beta / dt > 0, also the
     viscous stress of the step, beta D d eps / dt (stiffness-proportional damping), and the work that the
     last step's viscous stress ``viscous`` did on this step's strain. Points marked ``dead`` come out

@@ -7,7 +7,8 @@ First Piola-Kirchhoff stress and its derivative (the total-Lagrangian tangent):
     A_iJkL = dP_iJ/dF_kL = mu d_ik d_JL + lambda F^-1_Ji F^-1_Lk + (mu - lambda ln J) F^-1_Li F^-1_Jk
 
 Chosen over St Venant-Kirchhoff, which softens in compression and misses the end-moment ring by about
-0.15 L (DESIGN.md). For small strains it reduces to linear elasticity with the same E and nu.
+0.15 L (docs/design.md, 'Updated and total Lagrangian'). For small strains it reduces to linear
+elasticity with the same E and nu.
 """
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""Objective stress updates of the updated-Lagrangian path (Section 2.1.3; DESIGN.md "Updated Lagrangian").
+"""Objective stress updates of the updated-Lagrangian path (Section 2.1.3; docs/design.md,
+'Updated and total Lagrangian').
 
 An increment moves the body from the configuration x_n (the last rebuild, where the gradients live)
 to x_{n+1} = x_n + du. At each integration point, with L = d(du)/dx_n and the relative deformation
@@ -23,7 +24,7 @@ gradient f = I + L:
   gradient of the discrete field and was dropped: it moved the end-moment tip by up to 0.03 L.)
 
 Both return the first Piola-Kirchhoff stress relative to x_n, P_n = det f sigma f^-T, so the internal
-force and tangent are the total-Lagrangian operators on x_n (:mod:`ctmrpim.lagrangian_operators`).
+force and tangent are the total-Lagrangian operators on x_n (:mod:`ctmrpim.discretisation.lagrangian_operators`).
 Every formula here is analytic in f, so the consistent tangent dP_n/df, the geometric (initial-stress)
 part included, comes exactly from four complex steps (:func:`complex_step_tangent`).
 """
@@ -119,7 +120,7 @@ class LeftCauchyGreenUpdate:
     """Neo-Hookean in updated form (state: the left Cauchy-Green tensor b = F F^T, xx, yy, xy).
 
     b_{n+1} = f b_n f^T; Kirchhoff stress tau = mu (b - I) + lambda ln J I with J = sqrt(det b), the
-    same material as :class:`ctmrpim.hyperelastic.NeoHookean` (plane strain, F33 = 1)."""
+    same material as :class:`ctmrpim.materials.neo_hookean.NeoHookean` (plane strain, F33 = 1)."""
 
     n_state = 3
 
@@ -199,7 +200,7 @@ def hughes_winget_components(f00, f01, f10, f11):
     """The strain increment (exx, eyy, engineering gxy) and the rotation Q = [[c, -s], [s, c]] (c, s) of
     :func:`hughes_winget` from the components of f: G = L (I + L/2)^-1, Q = (I - W/2)^-1 (I + W/2) with
     W = skew G. Arithmetic only, so it serves arrays (:func:`hughes_winget_c`) and, compiled, one point
-    at a time (:mod:`ctmrpim.explicit_point_update`)."""
+    at a time (:mod:`ctmrpim.materials.mohr_coulomb_kernel`)."""
     L00, L01, L10, L11 = f00 - 1.0, f01, f10, f11 - 1.0
     A00, A01, A10, A11 = 1.0 + 0.5 * L00, 0.5 * L01, 0.5 * L10, 1.0 + 0.5 * L11
     det = A00 * A11 - A01 * A10

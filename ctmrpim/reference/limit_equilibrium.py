@@ -32,7 +32,7 @@ class SlipCircle:
 
 
 def top_surface(body) -> np.ndarray:
-    """Ground surface (k, 2) of a body (a :class:`ctmrpim.geometry.Geometry` or a shapely polygon):
+    """Ground surface (k, 2) of a body (a :class:`ctmrpim.problem.geometry.Geometry` or a shapely polygon):
     the highest boundary point above each vertex abscissa."""
     import shapely
 

@@ -5,8 +5,8 @@ value itself: the constrained dofs are eliminated and their values moved to the 
 
 Solvers (``method.solver``):
 
-* ``superlu``: SuperLU with the MMD_AT_PLUS_A ordering; measured in DESIGN.md it is 4-6 times faster
-  than scipy's default COLAMD ordering on these stiffness matrices.
+* ``superlu``: SuperLU with the MMD_AT_PLUS_A ordering; measured, it is 4-6 times faster than scipy's
+  default COLAMD ordering on these stiffness matrices (docs/design.md, 'Linear solvers').
 * ``banded``: reverse Cuthill-McKee ordering, then LAPACK's banded Cholesky (K is symmetric positive
   definite once constrained). On elongated bodies such as the cantilever the band is narrow and this
   wins: 0.48 s against 0.76 s for SuperLU at 129 x 33 nodes, measured here.

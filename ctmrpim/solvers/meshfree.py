@@ -1,12 +1,11 @@
-"""The CTM-RPIM method (``"ctm-rpim"`` of :mod:`ctmrpim.methods`): each analysis to its solver.
+"""The CTM-RPIM method (``METHOD``, ``"ctm-rpim"`` in :mod:`ctmrpim.methods`): each analysis to its solver.
 
-| analysis | material | solver |
-|---|---|---|
-| ``linear`` | linear elastic | :mod:`ctmrpim.solvers.linear_static` (Eqs. 4-6) |
-| ``quasi-static`` | neo-Hookean, linear elastic (rate form) | :mod:`ctmrpim.solvers.updated_lagrangian` (the paper's adaptive method), or :mod:`ctmrpim.solvers.total_lagrangian` |
-| ``quasi-static`` | Mohr-Coulomb (small strain) | :mod:`ctmrpim.solvers.elastoplastic` |
-| ``strength-reduction``, ``dynamic`` | Mohr-Coulomb | :mod:`ctmrpim.solvers.elastoplastic` (Eqs. 38-39, Eq. 11) |
-| ``explicit`` | Mohr-Coulomb | :mod:`ctmrpim.solvers.explicit` (Eqs. 8-11) |
+- ``linear`` (linear elastic): :mod:`ctmrpim.solvers.linear_static` (Eqs. 4-6);
+- ``quasi-static`` with neo-Hookean or linear elastic (rate form): :mod:`ctmrpim.solvers.updated_lagrangian`
+  (the paper's adaptive method) or :mod:`ctmrpim.solvers.total_lagrangian`;
+- ``quasi-static`` with Mohr-Coulomb (small strain), ``strength-reduction`` (Eqs. 38-39) and ``dynamic``
+  (relaxation, Eq. 11): :mod:`ctmrpim.solvers.elastoplastic`;
+- ``explicit`` (Mohr-Coulomb): :mod:`ctmrpim.solvers.explicit` (Eqs. 8-11).
 """
 from __future__ import annotations
 
@@ -14,6 +13,7 @@ import tempfile
 from pathlib import Path
 
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
+from ctmrpim.methods import SolutionMethod
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result
 from ctmrpim.run_options import RunOptions
@@ -41,3 +41,7 @@ def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Resu
     from ctmrpim.solvers.linear_static import solve_ctmrpim
     return solve_ctmrpim(case)
 
+
+#: the entry point ``ctmrpim.methods: ctm-rpim``
+METHOD = SolutionMethod("ctm-rpim", solve_meshfree, description="adaptive CTM-RPIM (CTM integration, RPIM shape "
+                                                                "functions, alpha-shape boundary)")

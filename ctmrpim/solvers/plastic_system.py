@@ -55,7 +55,7 @@ FROM_GRAD = np.array([[1.0, 0, 0, 0], [0, 0, 0, 1], [0, 1, 1, 0]])
 #: the whole run); 0.1 still swaps a pivot that has become tiny against its column (a plastic tangent
 #: can be near-singular).
 PIVOT_THRESHOLD = 0.1
-#: Anderson mixing depth of the iteration steps (see :class:`ctmrpim.load_stepping.Anderson`).
+#: Anderson mixing depth of the iteration steps (see :class:`ctmrpim.solvers.load_stepping.Anderson`).
 ANDERSON = 10
 
 

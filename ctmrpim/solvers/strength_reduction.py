@@ -8,10 +8,10 @@ The strengths are divided by the strength reduction factor SRF,
 it stays 0; a tension cut-off, a strength like c, is divided by SRF too), and the body is equilibrated
 under its full loads, by one of two solvers:
 
-- ``solver = "newton"``: load stepping (:mod:`ctmrpim.load_stepping`); a level is **failed** when Newton
+- ``solver = "newton"``: load stepping (:mod:`ctmrpim.solvers.load_stepping`); a level is **failed** when Newton
   cannot reach equilibrium: the SRF sub-step was cut back ``loading.max_cutbacks`` times and still did
   not converge within ``loading.max_iterations`` iterations;
-- ``solver = "dynamic-relaxation"`` (the paper's, :mod:`ctmrpim.dynamic_relaxation`): the reduction
+- ``solver = "dynamic-relaxation"`` (the paper's, :mod:`ctmrpim.solvers.dynamic_relaxation`): the reduction
   applied at once and relaxed; a level is **failed** when it is still moving after ``dynamic.steps``
   steps (not at rest, and its maximum displacement grew by more than ``SETTLED_GROWTH`` over the last
   quarter of the steps: the paper's "the displacement increases continuously").
@@ -197,7 +197,7 @@ def bracket(levels: list[Level]) -> tuple[float | None, float | None]:
 def solve_strength_reduction(case, system, out, base: Result,
                              progress: Callable[[Level], None] = lambda level: None) -> Result:
     """Run the ``[strength-reduction]`` of ``case`` on ``system`` (any discretisation, reported through
-    ``out``, a :class:`ctmrpim.elastoplastic.PlasticOutput`) and fill ``base`` with the last stable
+    ``out``, a :class:`ctmrpim.solvers.plastic_system.PlasticOutput`) and fill ``base`` with the last stable
     state, the levels in the history and the series, and the factor of safety as a bracket."""
     settings: StrengthReduction = case.strength_reduction
     material = case.problem.material

@@ -1,11 +1,11 @@
 """Quasi-static total-Lagrangian CTM-RPIM with a hyperelastic material (Section 2.1.3, TL form).
 
-The cross-check of the adaptive updated-Lagrangian path (DESIGN.md): boundary, CTM points, RPIM
-supports and shape functions all live on the reference configuration and are built once. Loads are
-applied in increments (:mod:`ctmrpim.load_stepping`); each increment is solved by Newton-Raphson on
-F_ext - F_int with a residual and a displacement criterion. An increment that does not converge is
-cut in half and retried (and the history says so, never silently), and grows back after easy
-increments. Loads are dead or follower (:mod:`ctmrpim.boundary_loads`).
+The cross-check of the adaptive updated-Lagrangian path (docs/design.md, 'Updated and total Lagrangian'):
+boundary, CTM points, RPIM supports and shape functions all live on the reference configuration and are
+built once. Loads are applied in increments (:mod:`ctmrpim.solvers.load_stepping`); each increment is
+solved by Newton-Raphson on F_ext - F_int with a residual and a displacement criterion. An increment that
+does not converge is cut in half and retried (and the history says so, never silently), and grows back
+after easy increments. Loads are dead or follower (:mod:`ctmrpim.discretisation.boundary_loads`).
 
     F_int[I, i] = sum_p w_p P_iJ(p) dN_I/dX_J(p)
     K[(I, i), (K, k)] = sum_p w_p dN_I/dX_J A_iJkL dN_K/dX_L        (G^T diag(w A) G, sparse)

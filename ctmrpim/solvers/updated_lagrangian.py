@@ -12,23 +12,23 @@ Raphson solves F_ext - F_int = 0 for the displacement increment du with
 
 P_n = det f sigma f^-T the first Piola-Kirchhoff stress relative to x_n, f = I + d(du)/dx_n. This is
 F_int = sum_p w_{n+1} sigma grad N_{n+1} on x_{n+1} (grad N_{n+1} = grad N_n f^-1, w_{n+1} = w_n det f)
-written without a rebuild. The stress update is objective (:mod:`ctmrpim.objective_stress`: Hughes-
+written without a rebuild. The stress update is objective (:mod:`ctmrpim.materials.objective_stress`: Hughes-
 Winget rotation for the rate form of linear elasticity, the left Cauchy-Green tensor for neo-
 Hookean) and the tangent its exact derivative (complex steps), geometric part included.
 
-Where state lives (DESIGN.md): at the integration points. On a rebuild it is L2-projected onto the
-nodes over the old points and evaluated at the new points (:mod:`ctmrpim.state_transfer`); the
-number of transfers is reported. After the last increment nothing is rebuilt (nothing is solved
-there), and where the alpha shape cannot separate parts that touch (the tip face reaching the root
-at the full end moment) the rebuild is skipped and the history says so: the points then move with
-the body and keep their shape functions, which is exact (it is the total-Lagrangian form relative
-to the last rebuild). Tags are fixed on the reference configuration: constrained dofs,
-loaded boundary segments (node pairs, each Gauss point at its fraction along its segment), probes
-and point loads (material points, carried by the RPIM interpolation of du). Alpha triangles and RPIM
-supports only join nodes that were neighbours in the reference configuration (within 2 alpha and 2
-r_c), so parts of the body that come together (the ends of the rolled-up beam) are not welded. The
-tracked area is compared with the previous configuration's after every rebuild; a jump of more than
-AREA_JUMP means the alpha shape opened or closed a gap, and the solve stops saying so.
+Where state lives (docs/design.md, 'State under re-tracking'): at the integration points. On a rebuild it
+is L2-projected onto the nodes over the old points and evaluated at the new points
+(:mod:`ctmrpim.discretisation.state_transfer`); the number of transfers is reported. After the last
+increment nothing is rebuilt (nothing is solved there), and where the alpha shape cannot separate parts
+that touch (the tip face reaching the root at the full end moment) the rebuild is skipped and the history
+says so: the points then move with the body and keep their shape functions, which is exact (it is the
+total-Lagrangian form relative to the last rebuild). Tags are fixed on the reference configuration:
+constrained dofs, loaded boundary segments (node pairs, each Gauss point at its fraction along its
+segment), probes and point loads (material points, carried by the RPIM interpolation of du). Alpha
+triangles and RPIM supports only join nodes that were neighbours in the reference configuration (within 2
+alpha and 2 r_c), so parts of the body that come together (the ends of the rolled-up beam) are not
+welded. The tracked area is compared with the previous configuration's after every rebuild; a jump of
+more than AREA_JUMP means the alpha shape opened or closed a gap, and the solve stops saying so.
 """
 from __future__ import annotations
 
@@ -63,7 +63,8 @@ from ctmrpim.solvers.load_stepping import step_loads
 from ctmrpim.solvers.weak_form import internal_force, tangent
 from ctmrpim.timing import Timer
 
-#: Largest relative change of the tracked area from one configuration to the next (DESIGN.md).
+#: Largest relative change of the tracked area from one configuration to the next (docs/design.md,
+#: 'Boundary tracking').
 AREA_JUMP = 0.02
 #: Alpha triangles and RPIM supports join only nodes this many alpha / r_c apart in the reference.
 REFERENCE_NEIGHBOURS = 2.0

@@ -1,4 +1,4 @@
-"""Stable time step of the central-difference scheme (Section 2.1.4; DESIGN.md "Solvers").
+"""Stable time step of the central-difference scheme (Section 2.1.4; docs/design.md, 'Explicit dynamics').
 
 Central differences are stable for dt <= 2 / omega_max, omega_max^2 the largest eigenvalue of
 M^-1 K (lumped mass, elastic stiffness). omega_max is estimated by power iteration with the elastic
@@ -6,13 +6,17 @@ internal-force operator of the current configuration (one gradient and one trans
 iteration, no matrix assembled), warm-started from the last estimate's vector at each rebuild; the
 step is dt = cfl x 2 / omega_max (cfl = 0.5 covers the estimate's shortfall, plasticity and contact),
 shortened by the stiffness-proportional damping where there is one (:func:`stable_step`).
-The textbook bound 0.4 d_min / c_p (c_p the P-wave speed) is reported beside it.
+The textbook bound 0.4 d_min / c_p (c_p the P-wave speed) is reported beside it. The explicit run
+recomputes the step on its frame at every rebuild (:class:`TimeStepping`).
 """
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
+from scipy.spatial import cKDTree
+
+from ctmrpim.discretisation.configuration import Configuration
 
 #: Power iterations of the first estimate, and of the later ones (warm-started from the last vector: the
 #: stiffest mode changes little between rebuilds).
@@ -59,3 +63,34 @@ def wave_speed_step(d_min: float, E: float, nu: float, density: float, factor: f
     """factor x d_min / c_p, with the plane-strain P-wave modulus."""
     modulus = E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
     return factor * d_min / float(np.sqrt(modulus / density))
+
+
+def smallest_spacing(x: np.ndarray) -> float:
+    """The smallest distance between two of the nodes x (n, 2): d_min of :func:`wave_speed_step`."""
+    d, _ = cKDTree(x).query(x, k=2)
+    return float(d[:, 1].min())
+
+
+class TimeStepping:
+    """The stable step of an :class:`~ctmrpim.solvers.explicit.run.ExplicitRun` on its current frame (a mixin
+    of it: reads the run's ``settings``, ``D``, ``mass``, ``movable`` and ``frame``; sets ``omega``, ``mode``
+    (the power iteration's vector, its next start), ``dt`` and ``dt_range``)."""
+
+    def _stiffness(self, frame: Configuration) -> Callable[[np.ndarray], np.ndarray]:
+        """d (n, 2) -> elastic small-strain force K d (n, 2) on the frame (for the time step)."""
+        def apply(d: np.ndarray) -> np.ndarray:
+            L = frame.gradient(d)
+            eps = np.c_[L[:, 0] - 1.0, L[:, 3] - 1.0, L[:, 1] + L[:, 2]]
+            s = eps @ self.D.T
+            return frame.force(np.c_[s[:, 0], s[:, 2], s[:, 2], s[:, 1]])
+        return apply
+
+    def _time_step(self) -> None:
+        """omega_max on the current frame (warm-started from ``mode`` after the first) and the step from it."""
+        s = self.settings
+        first = not np.isfinite(self.dt_range[0])
+        omega, self.mode = omega_max(self._stiffness(self.frame), self.mass, self.mode, self.movable,
+                                     ITERATIONS if first else WARM_ITERATIONS)
+        self.omega = omega
+        self.dt = float(s.dt) if s.dt != "cfl" else stable_step(omega, s.cfl, s.viscosity)
+        self.dt_range = [min(self.dt_range[0], self.dt), max(self.dt_range[1], self.dt)]

@@ -1,0 +1,62 @@
+"""The verification report: ``reports/REPORT.md`` with its tables (CSV) and figures (PNG).
+
+It runs every study (``studies/``) through the sweep executor, checks every verified number and
+every claim of the paper against the tolerances table, and writes them side by side: the paper's
+statement, our value, the analytical reference, the finite-element value, pass/fail.
+
+``make_report`` (here) runs the studies and writes the sections in order; ``checks`` holds the
+tolerance checks, ``markdown`` the table formatting, and ``summary``, ``linear``,
+``large_deformation``, ``stability`` and ``dynamics`` one function per section.
+"""
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import studies
+from ctmrpim.io.atomic import atomic_write_text
+from studies.report import dynamics, large_deformation, linear, stability, summary
+from studies.report.checks import all_checks, claims_table, console_summary
+from studies.report.markdown import Progress
+from studies.sweep import Sweep
+from studies.time_to_accuracy import targets_table
+
+__all__ = ["make_report"]
+
+
+def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Sweep | None = None,
+                progress: Progress = print) -> Path:
+    """Run every study (quick or full mode) into ``out_dir``, write ``out_dir/REPORT.md`` and print the
+    checks through ``progress``; the report's path."""
+    out_dir = Path(out_dir)
+    tables = {name: studies.run(name, quick, out_dir, sweep, progress) for name in studies.NAMES}
+    checks = all_checks(tables)
+    claim_rows = claims_table(tables)
+    buf = io.StringIO()
+    w = buf.write
+    summary.write_title(w, quick, checks, claim_rows)
+    summary.write_claims(w, claim_rows)
+    summary.write_accuracy_checks(w, checks)
+    linear.write_node_density(w, tables["node_density"])
+    linear.write_time_to_accuracy(w, targets_table(tables["time_to_accuracy"]))
+    linear.write_parameter_studies(w, tables)
+    linear.write_plate_hole(w, tables["plate_hole_convergence"])
+    large_deformation.write_tip_load(w, tables["tip_load"])
+    large_deformation.write_end_moment(w, tables["end_moment"])
+    large_deformation.write_deformed_shapes(w, quick, out_dir, progress)
+    stability.write_side_by_side(w, tables["slope_stability"], tables["footing_bearing"])
+    stability.write_slope_stability(w, tables["slope_stability"])
+    stability.write_srf_sweep(w, tables["slope_srf_sweep"])
+    stability.write_relaxation(w, tables["slope_relaxation"])
+    stability.write_footing(w, tables["footing_bearing"])
+    stability.write_stability_fields(w, quick, out_dir, progress)
+    stability.write_slope_slide(w, tables["slope_slide"])
+    dynamics.write_column_collapse(w, tables["column_collapse"], quick)
+    dynamics.write_collapse_settings(w, tables["column_collapse_settings"])
+    dynamics.write_collapse_viscosity(w, tables["column_collapse_viscosity"])
+    dynamics.write_full_mode_notes(w, out_dir)
+    path = out_dir / "REPORT.md"
+    atomic_write_text(path, buf.getvalue())
+    progress("\n" + console_summary(checks, claim_rows))
+    return path
+

@@ -1,0 +1,83 @@
+"""The linear sections: the cantilever (node density, time to accuracy, the method's parameters) and
+the plate with a circular hole."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+import studies
+from studies.node_density import rates
+from studies.report.markdown import Writer, md, pct
+
+ERRORS = ("tip_error", "l2_error", "energy_error")
+#: The parameter studies of the cantilever, each with its heading.
+PARAMETER_STUDIES = (("integration_density", "Integration density (cf. Fig. 10)"),
+                     ("support_radius", "Support radius (cf. Fig. 11)"),
+                     ("shape_parameter", "Shape parameter (cf. Fig. 12)"),
+                     ("parameter_map", "Support radius and shape parameter together (not in the paper)"))
+
+
+def write_node_density(w: Writer, nd: pd.DataFrame) -> None:
+    """Node density: CTM-RPIM against scikit-fem on the cantilever (Fig. 9), with the fitted rates."""
+    w("## Node density: cantilever, CTM-RPIM against scikit-fem (cf. Fig. 9)\n\n")
+    w("CTM-RPIM with eta = 5, r_c = 4 d_c, r_x = r_y = d_c/3, one Gauss point per sub-segment, linear or "
+      "quadratic augmentation; scikit-fem Q1 quadrilaterals, P1 and P2 triangles on the same node grid. "
+      "Times are wall seconds per solve on one core (sweep workers).\n\n")
+    w(md(pct(nd, ERRORS)))
+    w("\n\n")
+    w(md(rates(nd).round(2)))
+    ok = nd[nd.status == "ok"].set_index(["grid", "method"])
+    at33 = ok.xs("33 x 9", level="grid")
+    w(f"\n\n![node density](node_density.png)\n\nAt 33 x 9 nodes CTM-RPIM's tip error is "
+      f"{at33.loc['fem-q1', 'tip_error'] / at33.loc['ctm-rpim', 'tip_error']:.1f} times smaller than Q1's, "
+      f"as the paper claims; but P2 triangles on the same nodes are "
+      f"{at33.loc['ctm-rpim', 'tip_error'] / at33.loc['fem-p2', 'tip_error']:.0f} times more accurate than "
+      f"CTM-RPIM and {at33.loc['ctm-rpim', 'time_s'] / at33.loc['fem-p2', 'time_s']:.0f} times faster: on this "
+      "smooth problem a quadratic finite element beats CTM-RPIM at equal nodes.\n\n")
+
+
+def write_time_to_accuracy(w: Writer, tta: pd.DataFrame) -> None:
+    """Wall time to reach given tip errors (``tta``: ``time_to_accuracy.targets_table``), per method."""
+    w("## Time to accuracy\n\n")
+    w("Wall time per solve (one core) needed to reach a tip error of 1 %, 0.1 % and 0.01 %, interpolated "
+      "in log-log between the grids that bracket it; empty where no grid of this run reached it.\n\n")
+    w(md(tta.assign(**{c: tta[c].map(lambda v: "" if np.isnan(v) else f"{v:.3f} s") for c in tta.columns
+                        if c != "method"})))
+    t = tta.set_index("method")
+    for col in [c for c in t.columns if c.startswith("time_to_")]:
+        reached = t[col].dropna().sort_values()
+        if len(reached) >= 2:
+            w(f"\n\nFirst to {col[8:]}: {reached.index[0]}, {reached.iloc[1] / reached.iloc[0]:.1f} times sooner "
+              f"than {reached.index[1]}.")
+        elif len(reached) == 1:
+            w(f"\n\nOnly {reached.index[0]} reaches {col[8:]} in this run.")
+    for target in ("time_to_0.1%", "time_to_1%"):
+        if not np.isnan(t.loc["ctm-rpim", target]):
+            parts = [f"CTM-RPIM / {m}: x{t.loc['ctm-rpim', target] / t.loc[m, target]:.1f}"
+                     for m in ("fem-q1", "fem-p2") if m in t.index and not np.isnan(t.loc[m, target])]
+            w(f"\n\nTo reach {target[8:]}: " + ", ".join(parts) + " (above 1 means CTM-RPIM is slower).")
+            break
+    w(" CTM-RPIM's time goes to the RPIM moment systems (one dense solve of about 50 unknowns per "
+      "integration point, nine points per node) and the sparse products of the stiffness; see "
+      "`python performance/bench_linear.py` for the per-phase split.\n\n![time to accuracy](time_to_accuracy.png)\n\n")
+
+
+def write_parameter_studies(w: Writer, tables: dict[str, pd.DataFrame]) -> None:
+    """One section per parameter study of the cantilever (Figs. 10-12 and the parameter map)."""
+    for name, what in PARAMETER_STUDIES:
+        w(f"## {what}\n\n{studies.study(name).__doc__.strip()}\n\n")
+        w(md(pct(tables[name], ERRORS)))
+        w(f"\n\n![{name}]({name}.png)\n\n")
+
+
+def write_plate_hole(w: Writer, plate: pd.DataFrame) -> None:
+    """The plate with a circular hole against Kirsch's solution."""
+    w("## Plate with a circular hole (Kirsch)\n\n")
+    w(f"{studies.study('plate_hole_convergence').__doc__.strip()}\n\n")
+    w(md(pct(plate, ("l2_error", "energy_error")).drop(columns=["tip_error"])))
+    w("\n\n![plate with hole](plate_hole_convergence.png)\n\n")
+    w("Where CTM-RPIM is weak: the stress concentration sxx = 3T at (0, a), read at the boundary node, does "
+      "not converge with the paper's integration (one Gauss point, r = d_c/3): about 4450 at spacing 0.125 "
+      "and 5000 at 0.0625 against 3000 (full mode), because single-point line integration under-resolves the "
+      "cut cells along the arc (two Gauss points give 3185 at 0.125). The energy-norm error still falls with "
+      "refinement; P2 finite elements are more accurate at equal nodes here too.\n\n")
