@@ -29,6 +29,7 @@ COMMANDS = "ctmrpim.commands"
 
 
 def describe(result: Result, case: Case) -> str:
+    """The text summary ``ctmrpim run`` prints of a solved case: counts, probes and errors, outcome, timings."""
     c, t = result.counts, result.timings
     head = f"{case.problem.name} ({result.method}): {c.get('nodes')} nodes"
     d_c = result.parameters.get("derived", {}).get("d_c")
@@ -119,6 +120,7 @@ def _level_line(h: dict) -> str:
 
 
 def cmd_list(args: argparse.Namespace) -> int:
+    """``ctmrpim list``: print each benchmark's name, problem name and description; exit status 0."""
     for name in benchmarks.names():
         case = benchmarks.load(name)
         print(f"{name:16s} {case.resolved['problem']['name']}: {_description(name)}")
@@ -131,6 +133,7 @@ def _description(name: str) -> str:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    """``ctmrpim run TARGET``: solve a benchmark or problem file, write its outputs, print a summary; exit status 0."""
     case = load_case(args.target, args.set or [])
     element = methods.element_of(methods.get(args.solver), args.element)
     suffix = "" if args.solver == methods.DEFAULT else f"-{args.solver}" + (f"-{element}" if element else "")
@@ -155,6 +158,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``ctmrpim`` argument parser: ``list``, ``run`` and the commands of the ``ctmrpim.commands`` entry points."""
     ap = argparse.ArgumentParser(prog="ctmrpim", description="Adaptive CTM-RPIM meshfree solver and verification suite")
     sub = ap.add_subparsers(dest="command", required=True)
     p = sub.add_parser("list", help="list the benchmark problems")
@@ -177,6 +181,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the command line on ``argv`` (default ``sys.argv[1:]``); exit status 0, 2 on a ProblemError, 130 when
+    interrupted."""
     args = build_parser().parse_args(argv)
     with warnings.catch_warnings():
         warnings.simplefilter("always", UserWarning)

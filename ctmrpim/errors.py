@@ -17,6 +17,7 @@ class ProblemError(Exception):
 
     @property
     def message(self) -> str:
+        """The one-line message: ``source: key: reason``, leaving out what is not known."""
         parts = [p for p in (self.source, self.key) if p]
         return ": ".join(parts + [self.reason])
 

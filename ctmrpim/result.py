@@ -13,6 +13,7 @@ STRESS_NAMES = ("sxx", "syy", "sxy")
 
 @dataclass
 class Result:
+    """The result of one solve at n output points (field nodes or mesh vertices), whichever method produced it."""
     method: str                       # "ctm-rpim", "fem-q1", "fem-p1", "fem-p2"
     points: np.ndarray                # (n, 2) field nodes / mesh vertices
     u: np.ndarray                     # (n, 2) displacement at the points
@@ -31,6 +32,7 @@ class Result:
 
 
 def probe_record(x: float, y: float, u: np.ndarray, s: np.ndarray) -> dict[str, float]:
+    """A probe's record: its position (x, y), displacement u (2,): ux, uy and stress s (3,): sxx, syy, sxy."""
     return {"x": float(x), "y": float(y), "ux": float(u[0]), "uy": float(u[1]),
             **{k: float(v) for k, v in zip(STRESS_NAMES, s)}}
 

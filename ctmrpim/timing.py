@@ -37,6 +37,10 @@ class Timer:
         finally:
             self.add(name, time.perf_counter() - start)
 
+    def elapsed(self) -> float:
+        """Seconds since the start."""
+        return time.perf_counter() - self.t0
+
     def total(self) -> dict[str, float]:
         """The phases and ``total``, the time since the start."""
-        return {**self.phases, "total": time.perf_counter() - self.t0}
+        return {**self.phases, "total": self.elapsed()}

@@ -26,9 +26,16 @@ from ctmrpim.problem.case import Case
 from ctmrpim.result import Result, probe_record
 from ctmrpim.solvers.plastic_system import PlasticOutput, PlasticSystem, run_elastoplastic
 from ctmrpim.timing import Timer
-
-from .mesh import build_mesh
-from .solve import FACET_ORDER, SCALAR_ELEMENTS, _constrained_dofs, _load_vector, _locate, _selected_facets, _value
+from reference_fem.boundary_conditions import (
+    FACET_ORDER,
+    constrained_dofs,
+    field_values,
+    load_vector,
+    locate,
+    selected_facets,
+)
+from reference_fem.mesh import build_mesh
+from reference_fem.solve import SCALAR_ELEMENTS
 
 #: The linear element on the same cells: its hat functions average point values onto the vertices.
 LINEAR_ELEMENTS = {"q1": ElementQuad1, "p1": ElementTriP1, "p2": ElementTriP1}
@@ -69,17 +76,17 @@ def solve_fem_elastoplastic(case: Case, element: str = "p2",
     scalar = basis.with_element(scalar_element)
     thickness = problem.thickness
     w = thickness * np.asarray(basis.dx).ravel()
-    F_dead = thickness * _load_vector(problem, fm, vec, tol, basis.N)
+    F_dead = thickness * load_vector(problem, fm, vec, tol, basis.N)
     bx, by = problem.body_force
     body = thickness * LinearForm(lambda v, w_: bx * v[0] + by * v[1]).assemble(basis)
-    fixed, fixed_values = _constrained_dofs(problem, fm, basis, tol)
+    fixed, fixed_values = constrained_dofs(problem, fm, basis, tol)
     system = PlasticSystem(gradient_operator(basis).tobsr(blocksize=(4, 1)), w, fixed, fixed_values,
                            lambda factor: factor * F_dead, body, problem.material, tangent=case.loading.tangent)
     mass = splu(csc_matrix(BilinearForm(lambda u, v, w_: u * v).assemble(scalar)))
     nel, nq = basis.nelems, basis.X.shape[-1]
     hats = basis.with_element(LINEAR_ELEMENTS[element]())
     lumped = LinearForm(lambda f, w_: f).assemble(hats)
-    probe_at = [_locate(mesh, np.array([p.x, p.y]), fm.d_c, p.name) for p in problem.probes]
+    probe_at = [locate(mesh, np.array([p.x, p.y]), fm.d_c, p.name) for p in problem.probes]
     probe_u = [basis.probes(at) for at in probe_at]
     probe_s = [scalar.probes(at) for at in probe_at]
     timer.lap("assembly")
@@ -124,10 +131,10 @@ def _peak_traction(problem, fm, vec, tol: float) -> float:
     peak = 0.0
     for where, components in ([(tr.where, (tr.tx, tr.ty)) for tr in problem.tractions]
                               + [(pr.where, (pr.p,)) for pr in problem.pressures]):
-        _, facets = _selected_facets(where, fm, tol)
+        _, facets = selected_facets(where, fm, tol)
         if len(facets) == 0:
             continue
         xq = np.asarray(FacetBasis(fm.mesh, vec, facets=facets, intorder=FACET_ORDER).global_coordinates())
-        values = [_value(f, xq[0], xq[1]) for f in components]
+        values = [field_values(f, xq[0], xq[1]) for f in components]
         peak = max(peak, float(np.sqrt(sum(v ** 2 for v in values)).max()))
     return peak

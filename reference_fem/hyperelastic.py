@@ -15,8 +15,6 @@ for the nodal and probe values.
 """
 from __future__ import annotations
 
-import time
-
 import numpy as np
 from scipy.sparse import coo_matrix, csc_matrix
 from scipy.sparse.linalg import splu
@@ -25,20 +23,21 @@ from skfem import Basis, BilinearForm, ElementVector, FacetBasis, LinearForm, co
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.neo_hookean import NeoHookean
 from ctmrpim.problem.case import Case
+from ctmrpim.problem.model import Problem
 from ctmrpim.result import Result, probe_record
 from ctmrpim.solvers.load_stepping import step_loads
-
-from .mesh import FemMesh, build_mesh
-from .solve import (
+from ctmrpim.timing import Timer
+from reference_fem.boundary_conditions import (
     FACET_ORDER,
-    SCALAR_ELEMENTS,
-    _constrained_dofs,
-    _load_vector,
-    _locate,
-    _selected_facets,
-    _traction_form,
-    _value,
+    constrained_dofs,
+    field_values,
+    load_vector,
+    locate,
+    selected_facets,
+    traction_form,
 )
+from reference_fem.mesh import FemMesh, build_mesh
+from reference_fem.solve import SCALAR_ELEMENTS
 
 #: Quadrature degree of f_int and K (P, A are not polynomial: one order above the linear need for P2).
 TANGENT_ORDER = {"q1": 2, "p1": 1, "p2": 4}
@@ -98,12 +97,12 @@ def _follower_tractions(problem, fm: FemMesh, vec, tol: float, turn: str
     for i, tr in enumerate(problem.tractions):
         if not (tr.follower and tr.turn == turn):
             continue
-        _, facets = _selected_facets(tr.where, fm, tol)
+        _, facets = selected_facets(tr.where, fm, tol)
         if len(facets) == 0:
             raise ProblemError(f"where = {tr.where.text!r} selects no boundary segment", key=f"traction[{i}]")
         fb = FacetBasis(fm.mesh, vec, facets=facets, intorder=FACET_ORDER)
         xq = np.asarray(fb.global_coordinates())
-        out.append((facets, fb, _value(tr.tx, xq[0], xq[1]), _value(tr.ty, xq[0], xq[1])))
+        out.append((facets, fb, field_values(tr.tx, xq[0], xq[1]), field_values(tr.ty, xq[0], xq[1])))
     return out
 
 
@@ -120,11 +119,11 @@ class FaceFollower:
     between the face's two end vertices; the load stiffness is the rank-2 term
     -(F0 dc/dU + F90 ds/dU), non-zero in the four dofs of those vertices only."""
 
-    def __init__(self, problem, fm: FemMesh, vec, basis, tol: float):
+    def __init__(self, problem: Problem, fm: FemMesh, vec: ElementVector, basis: Basis, tol: float) -> None:
         self.faces: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         facets_all, F0, F90 = [], np.zeros(basis.N), np.zeros(basis.N)
         for facets, fb, tx, ty in _follower_tractions(problem, fm, vec, tol, "face"):
-            F0 += problem.thickness * _traction_form.assemble(fb, tx=tx, ty=ty)
+            F0 += problem.thickness * traction_form.assemble(fb, tx=tx, ty=ty)
             F90 += problem.thickness * _rotated_traction_form.assemble(fb, tx=tx, ty=ty)
             facets_all.append(facets)
         if not facets_all:
@@ -139,7 +138,8 @@ class FaceFollower:
         self.faces.append((basis.nodal_dofs[:, a], basis.nodal_dofs[:, b], fm.mesh.p[:, b] - fm.mesh.p[:, a], F0, F90))
 
     def forces(self, U: np.ndarray, factor: float) -> tuple[np.ndarray | float, coo_matrix | None]:
-        """F_ext of the face followers at load factor ``factor`` and its stiffness -dF_ext/dU."""
+        """F_ext (N,) of the face followers at dofs U (N,) and load factor ``factor`` and its stiffness -dF_ext/dU
+        (N x N); 0.0 and None without face followers."""
         F, K = 0.0, None
         for da, db, d0, F0, F90 in self.faces:
             d = d0 + U[db] - U[da]
@@ -184,7 +184,7 @@ def _cauchy(material: NeoHookean, basis: Basis, U: np.ndarray) -> np.ndarray:
 def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> Result:
     """Load-stepped total-Lagrangian Newton solve of a quasi-static neo-Hookean ``case`` with the finite
     element ``element`` ("q1", "p1" or "p2") on its node set, the mesh refined ``refine`` times."""
-    t0 = time.perf_counter()
+    timer = Timer()
     problem = case.problem
     material = problem.material
     if problem.analysis != "quasi-static" or not isinstance(material, NeoHookean):
@@ -211,12 +211,12 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
     basis = Basis(mesh, vec, intorder=TANGENT_ORDER[element])
     pbasis = Basis(mesh, vec, intorder=PROJECTION_ORDER)
     scalar = pbasis.with_element(scalar_element)
-    t1 = time.perf_counter()
+    timer.lap("mesh")
 
     thickness = problem.thickness
-    F_dead = thickness * _load_vector(problem, fm, vec, tol, basis.N)
-    fixed, fixed_values = _constrained_dofs(problem, fm, basis, tol)
-    probe_at = [_locate(mesh, np.array([p.x, p.y]), fm.d_c, p.name) for p in problem.probes]
+    F_dead = thickness * load_vector(problem, fm, vec, tol, basis.N)
+    fixed, fixed_values = constrained_dofs(problem, fm, basis, tol)
+    probe_at = [locate(mesh, np.array([p.x, p.y]), fm.d_c, p.name) for p in problem.probes]
     probe_u = [basis.probes(at) for at in probe_at]                  # (2, N) each
     mass = splu(csc_matrix(BilinearForm(lambda u, v, w: u * v).assemble(scalar)))
 
@@ -258,13 +258,13 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
 
     path = step_loads(basis.N, case.loading, fixed, fixed_values, assemble, solve_increment, on_converged)
     U, history = path.U, path.history
-    t2 = time.perf_counter()
+    timer.lap("solve")
 
     stress_dofs = nodal_stress(U)
     probes = {}
     for p, at, Pu in zip(problem.probes, probe_at, probe_u):
         probes[p.name] = probe_record(p.x, p.y, (Pu @ U).ravel(), (scalar.probes(at) @ stress_dofs)[0])
-    t3 = time.perf_counter()
+    timer.lap("postprocess")
 
     return Result(
         method=f"fem-{element}-tl", points=mesh.p.T.copy(), u=U[basis.nodal_dofs].T.copy(),
@@ -273,7 +273,7 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
                 "integration_points": int(np.asarray(basis.dx).size),
                 "load_increments": sum(h["converged"] for h in history), "newton_iterations": path.newton_iterations,
                 "cutbacks": path.cutbacks},
-        timings={"mesh": t1 - t0, "solve": t2 - t1, "postprocess": t3 - t2, "total": t3 - t0},
+        timings=timer.total(),
         history=history, series=series,
         parameters={**case.resolved, "derived": {"d_c": fm.d_c, "element": element, "refine": refine,
                                                  "mu": material.mu, "lambda": material.lam}},

@@ -26,6 +26,7 @@ SLIVER_AREA = 1e-10
 
 @dataclass
 class FemMesh:
+    """A scikit-fem mesh of a case's field nodes, with those nodes and their spacing d_c."""
     mesh: Mesh
     nodes: np.ndarray      # (n, 2) the field nodes the mesh was built on (before any unused were dropped)
     d_c: float             # mean node spacing of those nodes (Eq. 36), the unit of the match tolerance

@@ -5,6 +5,7 @@ or ``ctmrpim study NAME [--quick]``), sends its cases through the sweep executor
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from importlib import import_module
 from pathlib import Path
 from types import ModuleType
@@ -12,6 +13,8 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from studies.sweep import Sweep
 
 NAMES = ["node_density", "integration_density", "support_radius", "shape_parameter", "parameter_map",
          "time_to_accuracy", "plate_hole_convergence", "tip_load", "end_moment", "slope_stability",
@@ -22,10 +25,12 @@ ALIASES = {n.replace("_", "-"): n for n in NAMES}
 
 
 def study(name: str) -> ModuleType:
+    """The module of study ``name`` (module name, or its command-line spelling with dashes)."""
     return import_module(f"studies.{ALIASES.get(name, name)}")
 
 
-def run(name: str, quick: bool = True, out_dir: Path = Path("reports"), sweep=None, progress=print) -> pd.DataFrame:
+def run(name: str, quick: bool = True, out_dir: Path = Path("reports"), sweep: Sweep | None = None,
+        progress: Callable[[str], object] = print) -> pd.DataFrame:
     """Run study ``name`` through the sweep executor; its table (also written as CSV and PNG)."""
     from .base import run_study
     return run_study(study(name), quick, out_dir, sweep, progress)

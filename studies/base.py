@@ -8,26 +8,32 @@ folder, such as an explicit run's time series); :func:`run_study` (or ``studies.
 from __future__ import annotations
 
 import inspect
+from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
 from ctmrpim.io.atomic import atomic_write, atomic_write_text
 from studies.sweep import CaseOutcome, CaseSpec, Sweep
 
+if TYPE_CHECKING:
+    import numpy as np
+    from matplotlib.figure import Figure
+
 CACHE = Path("runs") / "sweeps"   # one folder per case, named by the hash of its resolved input
 
 
 def method_name(spec: CaseSpec) -> str:
+    """The method column of a case's row: ``fem-ELEMENT``, ``ctm-rpim`` or ``ctm-rpim-quadratic``."""
     if spec.solver == "fem":
         return f"fem-{spec.element}"
     quadratic = any(o.replace(" ", "") == 'method.polynomial="quadratic"' for o in spec.overrides)
     return "ctm-rpim-quadratic" if quadratic else "ctm-rpim"
 
 
-def metrics(outcome: CaseOutcome, extra=None) -> dict[str, Any]:
+def metrics(outcome: CaseOutcome, extra: Callable[..., dict[str, Any]] | None = None) -> dict[str, Any]:
     """The numbers a study tabulates from one case's summary.json (plus ``extra(summary)``)."""
     row: dict[str, Any] = {**outcome.spec.label_dict(), "method": method_name(outcome.spec),
                            "status": outcome.status}
@@ -47,7 +53,10 @@ def metrics(outcome: CaseOutcome, extra=None) -> dict[str, Any]:
 
 
 def run_study(module: ModuleType, quick: bool = True, out_dir: Path = Path("reports"),
-              sweep: Sweep | None = None, progress=print) -> pd.DataFrame:
+              sweep: Sweep | None = None, progress: Callable[[str], object] = print) -> pd.DataFrame:
+    """Run the study ``module``'s cases (quick or full) through ``sweep`` (default: a local one cached under
+    ``runs/sweeps``), report through ``progress``, write ``NAME.csv`` and ``NAME.png`` to ``out_dir``; its table,
+    one row per case (:func:`metrics`)."""
     sweep = sweep or Sweep(CACHE)
     specs = module.specs(quick)
     progress(f"study {module.NAME} ({'quick' if quick else 'full'}): {len(specs)} cases")
@@ -64,7 +73,7 @@ def run_study(module: ModuleType, quick: bool = True, out_dir: Path = Path("repo
     return df
 
 
-def save_figure(fig, path: Path) -> Path:
+def save_figure(fig: Figure, path: Path) -> Path:
     """Write a figure as PNG atomically and release it."""
     import matplotlib.pyplot as plt
 
@@ -73,8 +82,9 @@ def save_figure(fig, path: Path) -> Path:
     return path
 
 
-def finished(fig, axes, which: str = "major", fontsize: int = 8):
-    """The common finish of a study figure: grid and legend on every axis, tight layout."""
+def finished(fig: Figure, axes: np.ndarray, which: str = "major", fontsize: int = 8) -> Figure:
+    """The common finish of a study figure: grid and legend on every axis of ``axes`` (an array of them), tight
+    layout; the figure."""
     for ax in axes.ravel():
         ax.grid(True, which=which, alpha=0.3)
         ax.legend(fontsize=fontsize)
@@ -82,7 +92,9 @@ def finished(fig, axes, which: str = "major", fontsize: int = 8):
     return fig
 
 
-def new_figure(ncols: int = 1, width: float = 5.5):
+def new_figure(ncols: int = 1, width: float = 5.5) -> tuple[Figure, np.ndarray]:
+    """A new figure (Agg backend) with one row of ``ncols`` axes, each ``width`` x 4 inches: (figure, axes
+    (1, ncols))."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -11,6 +11,8 @@ from .base import CACHE, run_study
 
 
 def main(module: ModuleType) -> None:
+    """``python -m studies.NAME [--quick] [--out DIR] [--workers N] [--scheduler ADDRESS]``: run study ``module`` and
+    print its table."""
     ap = argparse.ArgumentParser(description=(module.__doc__ or "").strip().splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="the small version CI runs")
     ap.add_argument("--out", default="reports", help="folder for the CSV and PNG (default reports/)")

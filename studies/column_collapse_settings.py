@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -21,6 +23,9 @@ from ctmrpim.reference.deposit import surface_profile
 from studies.sweep import CaseSpec
 
 from . import column_collapse
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 NAME = "column_collapse_settings"
 TITLE = "Column collapse: deposit against the rebuild criterion and the time step (496 nodes)"
@@ -37,12 +42,16 @@ VARIANTS = {"full": [("default", ()), ("rebuild_strain 0.1", ("explicit.rebuild_
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """One case per solver-setting variant on the coarse cloud to t = ``EARLY`` (quick: two rebuild criteria on
+    16 x 9 nodes for 0.1 s)."""
     grid = ("nodes.grid=[16, 9]",) + column_collapse.QUICK if quick else (GRID, f"explicit.duration={EARLY}")
     return [CaseSpec("column-collapse", grid + extra, labels=(("variant", name),))
             for name, extra in VARIANTS["quick" if quick else "full"]]
 
 
-def extra(summary: dict, folder) -> dict:
+def extra(summary: dict, folder: Path) -> dict:
+    """:func:`column_collapse.extra` plus the surface at ``EARLY`` (time, front, profile on ``EARLY_XS``), read
+    from the run's ``folder``."""
     t, mesh = column_collapse.state_at(folder, EARLY)
     h = surface_profile(mesh.points[:, :2], column_collapse.boundary_edges(mesh), EARLY_XS)
     front = column_collapse.run_out(EARLY_XS, h, column_collapse.RUN_OUT_THICKNESS)
@@ -67,7 +76,8 @@ def early_differences(df: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """The surface of each variant at ``EARLY``, and each variant's wall time."""
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 2, figsize=(14, 4), gridspec_kw={"width_ratios": [2.5, 1]})

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
@@ -22,6 +24,9 @@ from studies.sweep import CaseSpec
 
 from . import column_collapse
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 NAME = "column_collapse_viscosity"
 TITLE = "Column collapse: the deposit against the viscosity beta (496 nodes, each run to rest)"
 GRID = "nodes.grid=[31, 16]"
@@ -29,18 +34,23 @@ VALUES = {"full": (0.0, 2.5e-6, 5e-6, 1e-5, 2e-5), "quick": (0.0, 5e-6)}
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """One case per viscosity beta on the coarse cloud, each to rest (at most 1.5 s; quick: none and the
+    benchmark's, 16 x 9 nodes for 0.1 s)."""
     grid = ("nodes.grid=[16, 9]",) + column_collapse.QUICK if quick else (GRID, "explicit.duration=1.5")
     return [CaseSpec("column-collapse", grid + (f"explicit.viscosity={beta!r}",), labels=(("viscosity_s", beta),))
             for beta in VALUES["quick" if quick else "full"]]
 
 
-def extra(summary: dict, folder) -> dict:
+def extra(summary: dict, folder: Path) -> dict:
+    """:func:`column_collapse.extra` plus the share of the work of gravity that the viscosity dissipated."""
     e = summary["dynamics"]["energy"]
     share = e["viscous_dissipation"] / e["gravity_work"] if e["gravity_work"] else float("nan")
     return {**column_collapse.extra(summary, folder), "viscous_share": share}
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """The final surface of each beta against the experiment, and the surface's distance and run-out error
+    against beta."""
     import matplotlib.pyplot as plt
 
     ok = df[df.status == "ok"]

@@ -23,6 +23,8 @@ def _sweep(args: argparse.Namespace):
 
 
 def cmd_study(args: argparse.Namespace) -> int:
+    """``ctmrpim study NAME|all``: run the study (or every one) and print its table without the JSON columns; exit
+    status 0, a ProblemError for an unknown name."""
     import studies
 
     names = studies.NAMES if args.name == "all" else [args.name]
@@ -41,6 +43,7 @@ def cmd_study(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
+    """``ctmrpim report``: regenerate the verification report (quick unless ``--full``); exit status 0."""
     from studies.report import make_report
 
     path = make_report(quick=not args.full, out_dir=Path(args.out), sweep=_sweep(args))

@@ -11,6 +11,7 @@ At m = 1 the exact beam closes into a circle of radius L / (2 pi).
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -19,6 +20,9 @@ from ctmrpim.reference import elastica
 from studies.sweep import CaseSpec
 
 from .base import finished, new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 NAME = "end_moment"
 TITLE = "End moment: tip against the exact arc (cf. Figs. 16-17)"
@@ -34,6 +38,8 @@ FORMULATIONS = {"UL": ('method.formulation="updated-lagrangian"',),
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """Each formulation (UL, UL carried, TL; and scikit-fem P2, TL) at each moment fraction m, with increments in
+    proportion to m."""
     ms = QUICK if quick else FULL
     ours = [CaseSpec("end-moment", (f"parameters.m={m!r}", f"loading.steps={int(np.ceil(STEPS_PER_RING[short] * m))}",
                                     *overrides),
@@ -45,6 +51,7 @@ def specs(quick: bool) -> list[CaseSpec]:
 
 
 def extra(summary: dict) -> dict:
+    """The tip (x/L, y/L) against the exact arc (Eq. 37), their distance, the Newton iterations and cut-backs."""
     m = summary["parameters"]["parameters"]["m"]
     tip = summary["probes"]["tip"]
     x, y = 1.0 + tip["ux"] / LENGTH, tip["uy"] / LENGTH
@@ -53,7 +60,8 @@ def extra(summary: dict) -> dict:
             "newton_iterations": summary["counts"]["newton_iterations"], "cutbacks": summary["counts"]["cutbacks"]}
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """The tip of every case on the exact tip path (cf. Figs. 16-17)."""
     fig, axes = new_figure(1, 6.0)
     ax = axes[0, 0]
     t = np.linspace(1e-6, 2 * np.pi, 200)

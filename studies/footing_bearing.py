@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -20,6 +21,9 @@ from studies.sweep import CaseSpec, element_of
 
 from .base import finished, new_figure
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 NAME = "footing_bearing"
 TITLE = "Strip footing: pressure against settlement (cf. Fig. 24)"
 PRANDTL = (2.0 + math.pi) * 100.0      # kPa
@@ -27,6 +31,7 @@ GRIDS = {"quick": [(49, 21)], "full": [(37, 16), (49, 21), (73, 31)]}
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """CTM-RPIM and scikit-fem P2 on each node grid."""
     grids = GRIDS["quick" if quick else "full"]
     return [CaseSpec("footing", (f"parameters.nx={nx}", f"parameters.ny={ny}"), solver,
                      element_of(solver, "p2"), labels=(("grid", f"{nx} x {ny}"),))
@@ -34,6 +39,8 @@ def specs(quick: bool) -> list[CaseSpec]:
 
 
 def extra(summary: dict) -> dict:
+    """The limit-pressure bracket (kPa) and its worst relative difference from Prandtl's (Eq. 40), the
+    settlement at 500 kPa, the Newton iterations and the load-settlement curve (JSON)."""
     limit = summary["limit_pressure"]
     carried = [h for h in summary["history"] if h["converged"]]
     q_max = summary["parameters"]["parameters"]["q_max"]
@@ -50,7 +57,9 @@ def extra(summary: dict) -> dict:
             "curve": json.dumps({"q_kPa": q.round(3).tolist(), "w_m": w.tolist()})}
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """Pressure against the settlement of the footing centre for every case, with Prandtl's limit and the
+    published points (cf. Fig. 24)."""
     fig, axes = new_figure(1, 6.0)
     ax = axes[0, 0]
     ok = df[df.status == "ok"]

@@ -5,12 +5,16 @@ claims the error falls roughly exponentially in d_c/r and is satisfactory from d
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from studies.sweep import CaseSpec
 
 from .one_parameter import cantilever_specs, error_plot
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 NAME = "integration_density"
 TITLE = "Integration density (cf. Fig. 10)"
@@ -23,11 +27,13 @@ PAPER_RANGE = (3.0, 5.0)
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """The CTM-RPIM cantilever at each d_c/r (r_x = r_y = r) on each grid."""
     return cantilever_specs(PARAMETER, QUICK if quick else FULL, QUICK_GRIDS if quick else FULL_GRIDS,
                             lambda q: (f"method.line_spacing=[{1 / q!r}, {1 / q!r}]",))
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """Tip and energy-norm errors against d_c/r, the paper's satisfactory range shaded (cf. Fig. 10)."""
     return error_plot(df, PARAMETER, "d_c / r", TITLE, PAPER_RANGE)
 
 

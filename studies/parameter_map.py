@@ -5,6 +5,7 @@ whether the paper's one-at-a-time recommendations (r_c = 3.5-4 d_c, eta = 4.5-7.
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -13,6 +14,9 @@ from studies.sweep import CaseSpec
 
 from .base import new_figure
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 NAME = "parameter_map"
 TITLE = "Tip error over r_c and eta (17 x 5)"
 QUICK = ([2.0, 3.0, 4.0, 5.0, 6.0], [3.5, 5.5, 7.5])
@@ -20,13 +24,15 @@ FULL = ([2.0 + 0.5 * i for i in range(9)], [2.5 + 1.0 * i for i in range(8)])
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """The cantilever (17 x 5) at each pair of r_c/d_c and eta."""
     radii, etas = QUICK if quick else FULL
     return [CaseSpec("cantilever", ("nodes.grid=[17, 5]", f"method.support_radius={rc!r}", f"method.eta={eta!r}"),
                      labels=(("rc_over_dc", rc), ("eta", eta)))
             for rc in radii for eta in etas]
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """Heat map of the tip error (%) over r_c/d_c and eta."""
     grid = df.pivot(index="eta", columns="rc_over_dc", values="tip_error")
     fig, axes = new_figure(1, 6.5)
     ax = axes[0, 0]

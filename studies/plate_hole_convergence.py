@@ -5,6 +5,7 @@ concentration sxx(0, a) (exact 3 T) read at the boundary node.
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
@@ -13,6 +14,9 @@ from ctmrpim.problem.case import Case
 from studies.sweep import CaseSpec
 
 from .base import finished, new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 NAME = "plate_hole_convergence"
 TITLE = "Plate with a hole (Kirsch)"
@@ -23,23 +27,28 @@ PLANES = {"stress": 1, "strain": 0}   # the problem file's `ps` parameter must f
 
 
 def overrides(plane: str, spacing: float) -> tuple[str, ...]:
+    """The --set strings of a plate-hole case in ``plane`` (``stress`` or ``strain``) with node ``spacing``."""
     return (f"nodes.spacing={spacing}", f'problem.plane="{plane}"', f"parameters.ps={PLANES[plane]}")
 
 
 def case(plane: str, spacing: float) -> Case:
+    """The plate-hole benchmark in ``plane`` with node ``spacing``."""
     return benchmarks.load("plate-hole", list(overrides(plane, spacing)))
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """Each method (CTM-RPIM, scikit-fem P1, P2) in each plane state at each node spacing."""
     return [CaseSpec("plate-hole", overrides(plane, h), solver, element, labels=(("plane", plane), ("spacing", h)))
             for plane in PLANES for h in (QUICK_SPACINGS if quick else FULL_SPACINGS) for solver, element in METHODS]
 
 
 def extra(summary: dict) -> dict:
+    """The stress sxx at the top of the hole (probe ``hole_top``; exact 3 T)."""
     return {"sxx_hole_top": summary["probes"]["hole_top"]["sxx"]}
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """Energy-norm error and the stress concentration sxx(0, a) / T against the node count."""
     fig, axes = new_figure(2)
     for (method, plane), d in df[df.status == "ok"].groupby(["method", "plane"], sort=False):
         axes[0, 0].loglog(d.nodes, d.energy_error, "o-" if plane == "stress" else "s--", label=f"{method}, plane {plane}")

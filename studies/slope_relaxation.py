@@ -10,12 +10,16 @@ from __future__ import annotations
 
 import json
 import sys
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from studies.sweep import CaseSpec, element_of
 
 from .base import finished, new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 NAME = "slope_relaxation"
 TITLE = "Slope by dynamic relaxation: maximum displacement against step (cf. Fig. 19a)"
@@ -25,18 +29,23 @@ SOLVER = ('strength-reduction.solver="dynamic-relaxation"', "dynamic.steps=3000"
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """CTM-RPIM and scikit-fem P2 on the slope, each SRF on its own, by dynamic relaxation."""
     p = QUICK if quick else FULL
     return [CaseSpec("slope", (f"parameters.h={p['h']!r}", f"strength-reduction.values=[{s!r}]", *SOLVER), solver,
                      element_of(solver, "p2"), labels=(("srf", s),)) for s in p["srf"] for solver in ("ctm-rpim", "fem")]
 
 
 def extra(summary: dict) -> dict:
+    """The level's outcome: at rest or not, steps, maximum displacement and its history (JSON [step, maximum
+    displacement])."""
     level = summary["history"][0]
     return {"stable": level["stable"], "steps": level["iterations"], "max_displacement": level["max_displacement"],
             "history": json.dumps(level["displacement_history"])}
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """CTM-RPIM's maximum displacement against the step for each SRF (cf. Fig. 19a), and the final maximum
+    displacement against the SRF for both methods (cf. Fig. 19b)."""
     fig, axes = new_figure(2, 5.5)
     ok = df[df.status == "ok"].sort_values("srf")
     ax = axes[0, 0]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import meshio
 import numpy as np
@@ -18,16 +19,22 @@ import pandas as pd
 from ctmrpim.io.vtu import read_pvd
 from studies.sweep import CaseSpec
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 NAME = "slope_slide"
 TITLE = "Slope at SRF = 1.6: the slide at large deformation (cf. Fig. 21)"
 QUICK = ("parameters.h=1.5", "explicit.duration=1.5", "explicit.save_every=0.5")
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """The one slope-slide case (quick: the coarse cloud for 1.5 s)."""
     return [CaseSpec("slope-slide", QUICK if quick else (), labels=(("cloud", "quick" if quick else "default"),))]
 
 
 def extra(summary: dict, folder: Path) -> dict:
+    """The run's counts, maximum displacement, crest settlement, toe advance, plastic dissipation and time per
+    step, from its summary and the series in its ``folder``."""
     dyn = summary["dynamics"]
     states = read_pvd(Path(folder) / "result.pvd")
     first, last = meshio.read(states[0][1]), meshio.read(states[-1][1])
@@ -40,7 +47,9 @@ def extra(summary: dict, folder: Path) -> dict:
             "ms_per_step": 1e3 * dyn["seconds_per_step"]["total"]}
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """The initial and the final configuration, coloured by displacement and by equivalent plastic strain, with
+    the tracked boundary (cf. Fig. 21)."""
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(3, 1, figsize=(11, 10))

@@ -7,12 +7,16 @@ levels run in parallel). A stable level reports its converged maximum displaceme
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from studies.sweep import CaseSpec, element_of
 
 from .base import finished, new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 NAME = "slope_srf_sweep"
 TITLE = "Slope: maximum displacement against SRF (cf. Fig. 19b)"
@@ -21,18 +25,21 @@ FULL = {"h": 0.58, "srf": [0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.35, 1.4, 1.5, 1.6]}
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """CTM-RPIM and scikit-fem P2 on the slope, each SRF on its own (gravity ramped at the reduced strength)."""
     p = QUICK if quick else FULL
     return [CaseSpec("slope", (f"parameters.h={p['h']!r}", f"strength-reduction.values=[{s!r}]"), solver, element_of(solver, "p2"),
                      labels=(("srf", s),)) for s in p["srf"] for solver in ("ctm-rpim", "fem")]
 
 
 def extra(summary: dict) -> dict:
+    """The level's outcome: stable or not, maximum displacement, iterations and cut-backs."""
     level = summary["history"][0]
     return {"stable": level["stable"], "max_displacement": level["max_displacement"],
             "iterations": level["iterations"], "cutbacks": level["cutbacks"]}
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """Maximum displacement against the SRF for both methods, stable and failed levels marked (cf. Fig. 19b)."""
     fig, axes = new_figure(1, 6.0)
     ax = axes[0, 0]
     ok = df[df.status == "ok"]

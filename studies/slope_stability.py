@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import sys
 from functools import cache
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
@@ -22,6 +23,9 @@ from studies.sweep import CaseSpec, element_of
 
 from .base import finished, new_figure
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 NAME = "slope_stability"
 TITLE = "Slope factor of safety by strength reduction (cf. Figs. 18-19)"
 SPACING = {"slope": {"quick": [1.0], "full": [1.0, 0.58]}, "slope-gl": {"quick": [0.6], "full": [0.6, 0.35]}}
@@ -30,16 +34,19 @@ PAPER = (1.3, 1.4)
 
 @cache
 def bishop(target: str) -> float:
+    """Bishop's simplified factor of safety of benchmark ``target``'s critical circle."""
     return problem_factor_of_safety(benchmarks.load(target).problem).fs
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """CTM-RPIM and scikit-fem P2 on each slope geometry at each node spacing."""
     mode = "quick" if quick else "full"
     return [CaseSpec(target, (f"parameters.h={h!r}",), solver, element_of(solver, "p2"), labels=(("slope", target), ("h", h)))
             for target, hs in SPACING.items() for h in hs[mode] for solver in ("ctm-rpim", "fem")]
 
 
 def extra(summary: dict) -> dict:
+    """The factor-of-safety bracket, Bishop's, their worst relative difference, the levels and iterations."""
     fos = summary["factor_of_safety"]
     target = summary["parameters"]["problem"]["name"]
     reference = bishop(target)
@@ -49,7 +56,8 @@ def extra(summary: dict) -> dict:
             "iterations": summary["counts"]["newton_iterations"]}
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """The factor-of-safety bracket of every case against Bishop's and the paper's range (cf. Figs. 18-19)."""
     fig, axes = new_figure(1, 6.5)
     ax = axes[0, 0]
     ok = df[df.status == "ok"].reset_index(drop=True)

@@ -10,6 +10,7 @@ Writes ``stability_fields.png``.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +23,9 @@ from .base import new_figure, save_figure
 NAME = "stability_fields"
 
 
-def run(quick: bool = True, out_dir: Path = Path("reports"), progress=print) -> Path:
+def run(quick: bool = True, out_dir: Path = Path("reports"), progress: Callable[[str], object] = print) -> Path:
+    """Solve ``slope`` (strength reduction) and ``footing`` (to its limit load) and draw the slope's plastic strain
+    at the last stable and first failed SRF and the footing's mechanism (cf. Figs. 20 and 25); the PNG's path."""
     slope_h = 1.0 if quick else 0.58
     progress(f"stability fields: slope (h = {slope_h}) strength reduction, footing to its limit")
     slope = solve(benchmarks.load("slope", [f"parameters.h={slope_h!r}"]))

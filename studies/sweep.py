@@ -44,6 +44,7 @@ class CaseSpec:
     labels: tuple[tuple[str, Any], ...] = field(default=(), compare=False)  # study coordinates, not hashed
 
     def label_dict(self) -> dict[str, Any]:
+        """The study coordinates as a dict (label -> value)."""
         return dict(self.labels)
 
 
@@ -129,6 +130,8 @@ def run_case(spec: CaseSpec, folder: str, key: str, worker: bool = True) -> dict
 
 @dataclass
 class CaseOutcome:
+    """One case of a sweep after it ran (or was found in the cache): its folder, status (``ok`` or ``error``),
+    its ``summary.json`` as a dict (None unless ok) and the error message."""
     spec: CaseSpec
     folder: Path
     status: str
@@ -150,6 +153,7 @@ class Sweep:
         self.computed = 0   # cases actually run by the last call of run()
 
     def folder(self, key: str) -> Path:
+        """The case folder of hash ``key``: the root's subfolder named by its first 16 hex digits."""
         return self.root / key[:16]
 
     def _done(self, key: str) -> dict[str, Any] | None:
@@ -166,6 +170,8 @@ class Sweep:
         return None
 
     def run(self, specs: Iterable[CaseSpec], desc: str = "sweep") -> list[CaseOutcome]:
+        """Run the cases of ``specs`` not done yet (each distinct hash once; ``desc`` labels the progress bar) and
+        return the outcomes of all of them, in the order of ``specs``."""
         specs = list(specs)
         keys = [case_hash(s) for s in specs]
         todo = [i for i, k in enumerate(keys) if self._done(k) is None]

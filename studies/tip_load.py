@@ -11,6 +11,7 @@ end-shear variant as the finite-element reference of the same continuum.
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -19,6 +20,9 @@ from ctmrpim.reference import elastica
 from studies.sweep import CaseSpec
 
 from .base import finished, new_figure
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 NAME = "tip_load"
 TITLE = "Tip-loaded cantilever against the elastica (cf. Fig. 14)"
@@ -32,6 +36,8 @@ MIN_STEPS = {"UL": 6, "TL": 2}
 
 
 def specs(quick: bool) -> list[CaseSpec]:
+    """UL and TL CTM-RPIM on both load variants at each lambda, and scikit-fem P2 (TL) on the end shear;
+    increments in proportion to lambda."""
     lams = QUICK if quick else FULL
 
     def overrides(lam, fewest=2):
@@ -49,6 +55,8 @@ def specs(quick: bool) -> list[CaseSpec]:
 
 
 def extra(summary: dict) -> dict:
+    """Tip deflection w/L and shortening u/L against the elastica (with the end moment for the corner load),
+    their relative differences, the Newton iterations and cut-backs."""
     lam = summary["parameters"]["parameters"]["lam"]
     corner = summary["parameters"]["problem"]["name"] == "tip-load-corner"
     exact = elastica.tip_load_bvp(lam, eccentricity=ECCENTRICITY) if corner else elastica.tip_load_elliptic(lam)
@@ -59,7 +67,8 @@ def extra(summary: dict) -> dict:
             "newton_iterations": summary["counts"]["newton_iterations"], "cutbacks": summary["counts"]["cutbacks"]}
 
 
-def figure(df: pd.DataFrame):
+def figure(df: pd.DataFrame) -> Figure:
+    """w/L and u/L against lambda of every case on the elastica's curves (cf. Fig. 14)."""
     fig, axes = new_figure(1, 6.5)
     ax = axes[0, 0]
     lam = np.linspace(0.0, max(df.lam.max(), 0.1), 60)[1:]

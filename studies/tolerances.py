@@ -10,14 +10,17 @@ FILE = Path(__file__).with_name("tolerances.toml")
 
 @cache
 def table() -> dict[str, dict]:
+    """The whole table: key -> entry (``quantity``, ``reference``, ``min`` and/or ``max``, ``unit``, ``source``)."""
     return tomllib.loads(FILE.read_text())
 
 
 def entry(key: str) -> dict:
+    """The entry of ``key``."""
     return table()[key]
 
 
 def passes(key: str, value: float) -> bool:
+    """Whether ``value`` lies within the limits of ``key``."""
     e = entry(key)
     return e.get("min", -float("inf")) <= value <= e.get("max", float("inf"))
 
@@ -28,6 +31,7 @@ def is_dimensionless(key: str) -> bool:
 
 
 def describe_limit(key: str) -> str:
+    """The limits of ``key`` as text (``a .. b``, ``<= b`` or ``>= a``), relative errors in percent."""
     e = entry(key)
     pct = not is_dimensionless(key)
     fmt = (lambda v: f"{100 * v:.3g} %") if pct else (lambda v: f"{v:.3g}")

@@ -37,28 +37,33 @@ class Boundary:
         return np.concatenate([np.c_[lp, np.roll(lp, -1)] for lp in self.loops])
 
     def loop_coordinates(self) -> list[np.ndarray]:
+        """Each loop's node coordinates, (k, 2) for a loop of k nodes, in loop order."""
         return [self.points[lp] for lp in self.loops]
 
     @property
     def area(self) -> float:
+        """Area enclosed by the loops: outer loops count positive, holes negative."""
         return float(sum(signed_area(self.points[lp]) for lp in self.loops))
 
     @property
     def n_outer(self) -> int:
+        """Number of outer (counter-clockwise) loops: the body's separate parts."""
         return sum(signed_area(self.points[lp]) > 0 for lp in self.loops)
 
     @property
     def n_holes(self) -> int:
+        """Number of holes (clockwise loops)."""
         return len(self.loops) - self.n_outer
 
 
 def signed_area(xy: np.ndarray) -> float:
-    """Shoelace area of a closed polygon, positive when counter-clockwise."""
+    """Shoelace area of a closed polygon of vertices ``xy`` (k, 2), positive when counter-clockwise."""
     x, y = xy[:, 0], xy[:, 1]
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
 def circumradii(points: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """(t,) circumradius of each triangle ``tri`` (t, 3) of node indices into ``points`` (n, 2); inf if degenerate."""
     a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
     la = np.linalg.norm(b - c, axis=1)
     lb = np.linalg.norm(c - a, axis=1)

@@ -14,15 +14,18 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ctmrpim.problem.model import Problem
+
 
 def dof(node: np.ndarray, component: int) -> np.ndarray:
-    """Global dof numbers of a component (0 = x, 1 = y) at nodes."""
+    """Global dof numbers (shape of ``node``) of a component (0 = x, 1 = y) at node indices ``node``."""
     return 2 * np.asarray(node) + component
 
 
 def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: np.ndarray) -> sp.csr_matrix:
-    """K = sum_p B_p^T D B_p w_p (Eq. 5) for one constant D with D[0, 2] = D[1, 2] = 0 (isotropic or
-    orthotropic in its axes); rows and columns of dNdx and dNdy must share one sparsity pattern."""
+    """K (2n x 2n) = sum_p B_p^T D B_p w_p (Eq. 5) from the derivatives ``dNdx``, ``dNdy`` (m, n) at m points
+    with ``weights`` (m,), for one constant D (3, 3) with D[0, 2] = D[1, 2] = 0 (isotropic or orthotropic in
+    its axes); rows and columns of dNdx and dNdy must share one sparsity pattern."""
     if abs(D[0, 2]) > 0 or abs(D[1, 2]) > 0:
         raise NotImplementedError("stiffness() assumes D[0, 2] = D[1, 2] = 0 (isotropic or orthotropic)")
     n = dNdx.shape[1]
@@ -63,13 +66,14 @@ def _on_pattern(a: sp.csr_matrix, pattern: sp.csr_matrix) -> np.ndarray:
 
 
 def load_vector(N: sp.csr_matrix, weights: np.ndarray, tx: np.ndarray, ty: np.ndarray) -> np.ndarray:
-    """F = sum_j N_j^T t_j w_j J_j (Eq. 6, second term), interleaved dofs."""
+    """F (2n,) = sum_j N_j^T t_j w_j J_j (Eq. 6, second term), interleaved dofs, from shape functions ``N`` (k, n)
+    at k points with ``weights`` (k,) and load components ``tx``, ``ty`` (k,)."""
     return np.column_stack([N.T @ (tx * weights), N.T @ (ty * weights)]).ravel()
 
 
-def body_force_vector(N: sp.csr_matrix, weights: np.ndarray, problem) -> np.ndarray:
-    """F = sum_p N_p^T b w_p over the integration points, b = density * gravity (Eq. 6, body term);
-    ``weights`` include the thickness."""
+def body_force_vector(N: sp.csr_matrix, weights: np.ndarray, problem: Problem) -> np.ndarray:
+    """F (2n,) = sum_p N_p^T b w_p over the integration points, b = density * gravity (Eq. 6, body term), from
+    shape functions ``N`` (m, n) and ``weights`` (m,), which include the thickness."""
     bx, by = problem.body_force
     if bx == 0.0 and by == 0.0:
         return np.zeros(2 * N.shape[1])

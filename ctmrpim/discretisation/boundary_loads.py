@@ -23,6 +23,8 @@ from ctmrpim.discretisation.lagrangian_operators import difference_operator, val
 
 @dataclass
 class BoundaryLoads:
+    """The external loads of a large-deformation solve at m traction points of n nodes: dead and follower
+    tractions per unit reference length, and dead point loads."""
     N: sp.csr_matrix            # (m, n) shape functions at the traction points
     weights: np.ndarray         # (m,) reference length x thickness
     tx: np.ndarray              # (m,) nominal traction per unit reference length

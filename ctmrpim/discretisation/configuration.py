@@ -18,6 +18,7 @@ expressions.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -77,7 +78,7 @@ class Configuration:
             out[self.active] = False
         return out
 
-    def shape_functions_at(self, points: np.ndarray, derivatives: bool = True, **options) -> ShapeFunctions:
+    def shape_functions_at(self, points: np.ndarray, derivatives: bool = True, **options: Any) -> ShapeFunctions:
         """RPIM of this configuration's nodes at other ``points`` (k, 2): probes, tractions, error points
         (``options``: ``reference`` or the other keywords of :func:`~ctmrpim.discretisation.rpim.shape_functions`)."""
         return shape_functions(self.x, points, derivatives=derivatives, tree=self.tree, **options,
@@ -171,6 +172,7 @@ class ReferenceCloud:
 
     @property
     def d_c(self) -> float:
+        """Mean node spacing d_c of the reference cloud (Eq. 36)."""
         return self.lengths.d_c
 
 

@@ -25,12 +25,15 @@ from ctmrpim.errors import ProblemError
 
 @dataclass
 class Quadrature:
+    """CTM integration points (m, 2) and their weights w_x J_x w_y J_y (m,) (Eq. 24), laid on ``n_lines``
+    horizontal integration lines."""
     points: np.ndarray     # (m, 2)
     weights: np.ndarray    # (m,)
     n_lines: int
 
 
 def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre points and weights, each (n,), on [-1, 1]."""
     return np.polynomial.legendre.leggauss(n)
 
 
@@ -73,7 +76,7 @@ def integration_points(loops: list[np.ndarray], r_x: float, r_y: float, gauss_po
                        mode: str = "uniform", min_band: float = 0.0) -> Quadrature:
     """CTM integration points and weights over the region bounded by ``loops`` (Eqs. 22-24).
 
-    ``loops`` are closed polygons (outer counter-clockwise, holes clockwise, or any orientation:
+    ``loops`` are closed polygons, each (k, 2) (outer counter-clockwise, holes clockwise, or any orientation:
     the even-odd pairing of crossings needs none). In ``uniform`` mode bands have height about
     ``r_y`` and sub-segments length about ``r_x``; in ``exact`` mode bands also break at vertex
     ordinates and r_x, r_y only bound the band height and sub-segment length; vertex ordinates
@@ -120,6 +123,8 @@ def integration_points(loops: list[np.ndarray], r_x: float, r_y: float, gauss_po
 
 @dataclass
 class BoundaryQuadrature:
+    """Gauss points on boundary segments, for the traction term of Eq. 6: m points with their length weights,
+    outward normals and the segment (and node pair) each lies on."""
     points: np.ndarray     # (m, 2)
     weights: np.ndarray    # (m,) length weights
     normals: np.ndarray    # (m, 2) outward unit normals

@@ -46,7 +46,7 @@ def _force(indptr, indices, dx, dy, wP, out):
 class GradientOperator:
     """dN/dx and dN/dy (m points x n nodes, one sparsity pattern) as the two products above."""
 
-    def __init__(self, dNdx: sp.csr_matrix, dNdy: sp.csr_matrix):
+    def __init__(self, dNdx: sp.csr_matrix, dNdy: sp.csr_matrix) -> None:
         if not (np.array_equal(dNdx.indptr, dNdy.indptr) and np.array_equal(dNdx.indices, dNdy.indices)):
             raise ValueError("dN/dx and dN/dy must share one sparsity pattern")
         self.shape = dNdx.shape

@@ -45,6 +45,7 @@ def project_to_nodes(N: sp.csr_matrix, weights: np.ndarray, values: np.ndarray) 
 
 def transfer(N_old: sp.csr_matrix, w_old: np.ndarray, values: np.ndarray, N_new: sp.csr_matrix
              ) -> tuple[np.ndarray, np.ndarray]:
-    """``values`` at the old points, L2-projected and evaluated at the new points; also the nodal values."""
+    """``values`` (m_old, k) at the old points (shape functions ``N_old`` (m_old, n), weights ``w_old`` (m_old,)),
+    L2-projected and evaluated at the new points (``N_new`` (m_new, n)): (m_new, k), and the nodal values (n, k)."""
     nodal = project_to_nodes(N_old, w_old, values)
     return np.asarray(N_new @ nodal), nodal

@@ -23,6 +23,8 @@ NAME = "checkpoint.npz"
 
 
 def save_checkpoint(folder: Path, key: str, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> Path:
+    """Write ``meta`` (JSON-able) with ``key`` (the hash of the resolved input and the code) and ``arrays`` to
+    ``folder/checkpoint.npz``, atomically; its path."""
     path = Path(folder) / NAME
     payload = {f"a_{k}": np.asarray(v) for k, v in arrays.items()}
     payload["meta"] = np.array(json.dumps(to_jsonable({**meta, "key": key})))

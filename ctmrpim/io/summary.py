@@ -26,6 +26,8 @@ def to_jsonable(obj: Any) -> Any:
 
 
 def summary_dict(result: Result, source: str) -> dict[str, Any]:
+    """The content of ``summary.json``: version, ``source`` file, method, resolved parameters, defaults applied,
+    counts, timings, probes, errors, outcome and history of ``result``."""
     return {
         "ctmrpim_version": __version__,
         "source": source,
@@ -42,6 +44,7 @@ def summary_dict(result: Result, source: str) -> dict[str, Any]:
 
 
 def write_summary(result: Result, out_dir: Path, source: str) -> Path:
+    """Write ``out_dir/summary.json`` atomically; its path."""
     path = Path(out_dir) / "summary.json"
     atomic_write_text(path, json.dumps(to_jsonable(summary_dict(result, source)), indent=2) + "\n")
     return path

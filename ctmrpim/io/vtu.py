@@ -81,6 +81,8 @@ class SeriesWriter:
 
     def add(self, time: float, points: np.ndarray, cells: list[tuple[str, np.ndarray]],
             point_data: dict[str, np.ndarray]) -> Path:
+        """Write the state at ``time``: nodes ``points`` (n, 2) as vertex cells, further ``cells`` (type,
+        connectivity), ``point_data`` arrays (n, ...) by name; then rewrite the index. The new file's path."""
         n = len(points)
         name = f"series/step_{len(self.entries):05d}.vtu"
         mesh = meshio.Mesh(np.c_[points, np.zeros(n)], [("vertex", np.arange(n).reshape(-1, 1)), *cells],

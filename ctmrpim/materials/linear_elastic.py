@@ -10,6 +10,7 @@ from ctmrpim.errors import ProblemError
 
 @dataclass(frozen=True)
 class LinearElastic:
+    """Isotropic linear elastic material: Young's modulus E, Poisson's ratio nu, mass density."""
     E: float
     nu: float
     density: float = 0.0

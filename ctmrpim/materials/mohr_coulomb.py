@@ -39,6 +39,8 @@ ELASTIC, MAIN, RIGHT, LEFT, APEX, TENSION = 0, 1, 2, 3, 4, 5
 
 @dataclass(frozen=True)
 class MohrCoulomb:
+    """Mohr-Coulomb elastic-perfectly plastic material in plane strain (module docstring): E, nu, cohesion c,
+    friction and dilation angles phi, psi (degrees), density and an optional tension cut-off."""
     E: float
     nu: float
     c: float
@@ -60,13 +62,16 @@ class MohrCoulomb:
 
     @property
     def G(self) -> float:
+        """Shear modulus E / (2 (1 + nu))."""
         return self.E / (2.0 * (1.0 + self.nu))
 
     @property
     def K(self) -> float:
+        """Bulk modulus E / (3 (1 - 2 nu))."""
         return self.E / (3.0 * (1.0 - 2.0 * self.nu))
 
     def D(self, plane: str = "strain") -> np.ndarray:
+        """(3, 3) elasticity matrix relating (exx, eyy, gxy) to (sxx, syy, sxy)."""
         from ctmrpim.materials.linear_elastic import LinearElastic
         return LinearElastic(self.E, self.nu, self.density).D(plane)
 

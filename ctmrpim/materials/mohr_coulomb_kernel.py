@@ -31,6 +31,7 @@ _rotate = njit(cache=True)(rotate_components)
 
 
 class PointUpdate(NamedTuple):
+    """What :func:`point_update` returns for m integration points."""
     stress: np.ndarray          # (m, 4) Cauchy stress after the step
     plastic: np.ndarray         # (m, 4) plastic strain after the step
     region: np.ndarray          # (m,) return region

@@ -22,6 +22,7 @@ from ctmrpim.materials.linear_elastic import LinearElastic
 
 @dataclass(frozen=True)
 class NeoHookean:
+    """Compressible neo-Hookean material in plane strain (module docstring), of small-strain E, nu and density."""
     E: float
     nu: float
     density: float = 0.0
@@ -32,10 +33,12 @@ class NeoHookean:
 
     @property
     def mu(self) -> float:
+        """Lame's shear modulus mu = E / (2 (1 + nu))."""
         return self.E / (2.0 * (1.0 + self.nu))
 
     @property
     def lam(self) -> float:
+        """Lame's lambda = E nu / ((1 + nu) (1 - 2 nu))."""
         return self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
 
     def first_piola(self, F: np.ndarray) -> np.ndarray:

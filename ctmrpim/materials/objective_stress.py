@@ -40,6 +40,7 @@ COMPLEX_STEP = 1e-30
 
 
 def det2(a: np.ndarray) -> np.ndarray:
+    """(m,) determinants of (m, 2, 2) matrices (analytic: complex steps pass through)."""
     return a[:, 0, 0] * a[:, 1, 1] - a[:, 0, 1] * a[:, 1, 0]
 
 
@@ -50,7 +51,8 @@ def inv2(a: np.ndarray) -> np.ndarray:
 
 
 def hughes_winget(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Strain increment de = sym G and rotation Q = (I - dW/2)^-1 (I + dW/2), G = L (I + L/2)^-1."""
+    """Strain increment de = sym G and rotation Q = (I - dW/2)^-1 (I + dW/2), G = L (I + L/2)^-1, each (m, 2, 2),
+    of relative deformation gradients f = I + L (m, 2, 2)."""
     eye = np.eye(2)[None]
     L = f - eye
     G = L @ inv2(eye + 0.5 * L)
@@ -65,7 +67,8 @@ def largest_strain(F: np.ndarray) -> float:
 
 
 def check_orientation(f: np.ndarray) -> np.ndarray:
-    """det f, or a ProblemError naming the first point where the increment inverts the material."""
+    """(m,) det f of the increments f (m, 2, 2) (real part), or a ProblemError naming the first point where the
+    increment inverts the material."""
     J = det2(f.real)
     if np.any(J <= 0):
         i = int(np.argmin(J))
@@ -79,12 +82,13 @@ class HypoelasticUpdate:
 
     n_state = 4
 
-    def __init__(self, D: np.ndarray, plane: str):
+    def __init__(self, D: np.ndarray, plane: str) -> None:
         self.D = np.asarray(D, float)
         # szz increment in plane strain: lambda (de_xx + de_yy) = D[0, 1] (de_xx + de_yy)
         self.zz = self.D[0, 1] if plane == "strain" else 0.0
 
     def initial(self, m: int) -> np.ndarray:
+        """(m, 4) the stress-free state of m points."""
         return np.zeros((m, 4))
 
     def _update(self, f: np.ndarray, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -103,10 +107,14 @@ class HypoelasticUpdate:
         return sig, szz
 
     def first_piola(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+        """(m, 2, 2) P_n = det f sigma_{n+1} f^-T relative to x_n after the increments f (m, 2, 2) from ``state``
+        (m, 4), without the orientation check (analytic in f, for complex steps)."""
         sig, _ = self._update(f, state)
         return det2(f)[:, None, None] * sig @ inv2(f).transpose(0, 2, 1)
 
     def advance(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+        """(m, 4) the state sxx, syy, sxy, szz after the increments f (m, 2, 2); a ProblemError where f inverts the
+        material."""
         check_orientation(f)
         sig, szz = self._update(f, state)
         return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1], szz]
@@ -124,10 +132,11 @@ class LeftCauchyGreenUpdate:
 
     n_state = 3
 
-    def __init__(self, material: NeoHookean):
+    def __init__(self, material: NeoHookean) -> None:
         self.material = material
 
     def initial(self, m: int) -> np.ndarray:
+        """(m, 3) the undeformed state b = I of m points."""
         return np.tile([1.0, 1.0, 0.0], (m, 1))
 
     @staticmethod
@@ -144,20 +153,26 @@ class LeftCauchyGreenUpdate:
         return tau / J[:, None, None]
 
     def first_piola(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+        """(m, 2, 2) P_n = det f sigma_{n+1} f^-T relative to x_n after the increments f (m, 2, 2) from ``state``
+        (m, 3), without the orientation check (analytic in f, for complex steps)."""
         b = f @ self._b(state) @ f.transpose(0, 2, 1)
         return det2(f)[:, None, None] * self._cauchy(b) @ inv2(f).transpose(0, 2, 1)
 
     def advance(self, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+        """(m, 3) b_{n+1} = f b_n f^T (xx, yy, xy) after the increments f (m, 2, 2); a ProblemError where f inverts
+        the material."""
         check_orientation(f)
         b = f @ self._b(state) @ f.transpose(0, 2, 1)
         return np.c_[b[:, 0, 0], b[:, 1, 1], b[:, 0, 1]]
 
     def cauchy(self, state: np.ndarray) -> np.ndarray:
+        """(m, 3) Cauchy stress sxx, syy, sxy of the states (m, 3)."""
         sig = self._cauchy(self._b(state))
         return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1]]
 
 
-def complex_step_tangent(update, f: np.ndarray, state: np.ndarray) -> np.ndarray:
+def complex_step_tangent(update: HypoelasticUpdate | LeftCauchyGreenUpdate, f: np.ndarray, state: np.ndarray
+                         ) -> np.ndarray:
     """(m, 4, 4) A[c, k] = dP_n[c] / df[k], components c, k = 2 i + J, exact to round-off."""
     m = len(f)
     A = np.empty((m, 4, 4))
@@ -177,6 +192,7 @@ def complex_step_tangent(update, f: np.ndarray, state: np.ndarray) -> np.ndarray
 # tests/test_explicit_dynamics.py checks each against the matrix forms above.
 
 def det_c(F: np.ndarray) -> np.ndarray:
+    """(m,) det F of gradients F (m, 4: xx, xy, yx, yy)."""
     return F[:, 0] * F[:, 3] - F[:, 1] * F[:, 2]
 
 
@@ -196,7 +212,8 @@ def relative_c(F_new: np.ndarray, F: np.ndarray) -> np.ndarray:
     return np.stack([a00 * i00 + a01 * i10, a00 * i01 + a01 * i11, a10 * i00 + a11 * i10, a10 * i01 + a11 * i11], axis=1)
 
 
-def hughes_winget_components(f00, f01, f10, f11):
+def hughes_winget_components(f00: np.ndarray | float, f01: np.ndarray | float, f10: np.ndarray | float,
+                             f11: np.ndarray | float) -> tuple[np.ndarray | float, ...]:
     """The strain increment (exx, eyy, engineering gxy) and the rotation Q = [[c, -s], [s, c]] (c, s) of
     :func:`hughes_winget` from the components of f: G = L (I + L/2)^-1, Q = (I - W/2)^-1 (I + W/2) with
     W = skew G. Arithmetic only, so it serves arrays (:func:`hughes_winget_c`) and, compiled, one point
@@ -219,7 +236,8 @@ def hughes_winget_c(f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.stack([e0, e1, e2], axis=1), c, s
 
 
-def rotate_components(xx, yy, xy, c, s):
+def rotate_components(xx: np.ndarray | float, yy: np.ndarray | float, xy: np.ndarray | float, c: np.ndarray | float,
+                      s: np.ndarray | float) -> tuple[np.ndarray | float, np.ndarray | float, np.ndarray | float]:
     """The in-plane components of Q t Q^T for Q = [[c, -s], [s, c]] (arrays or, compiled, scalars)."""
     cc, ss, cs = c * c, s * s, c * s
     return cc * xx - 2.0 * cs * xy + ss * yy, ss * xx + 2.0 * cs * xy + cc * yy, cs * (xx - yy) + (cc - ss) * xy

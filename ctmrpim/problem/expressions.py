@@ -199,6 +199,7 @@ class Field:
 
     @property
     def text(self) -> str:
+        """The expression's source text."""
         return self.expr.text
 
     def __call__(self, x: np.ndarray, y: np.ndarray, t: float = 0.0, eq_tol: float = 0.0) -> np.ndarray:

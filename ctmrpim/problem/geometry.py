@@ -29,6 +29,8 @@ class Shape:
     data: tuple
 
     def polygon(self) -> Polygon:
+        """The shape as a shapely polygon (a circle by ``circle_segments()`` chords); a ProblemError if it is empty or
+        not simple."""
         if self.kind == "rectangle":
             x0, y0, x1, y1 = self.data
             if not (x1 > x0 and y1 > y0):
@@ -84,18 +86,22 @@ class Geometry:
 
     @property
     def area(self) -> float:
+        """Area of the body."""
         return float(self.region.area)
 
     @property
     def perimeter(self) -> float:
+        """Length of the body's boundary, holes included."""
         return float(self.region.length)
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
+        """(x_min, y_min, x_max, y_max) of the body."""
         return tuple(float(b) for b in self.region.bounds)
 
     @property
     def polygons(self) -> list[Polygon]:
+        """The body's parts, each a polygon with its holes."""
         return list(getattr(self.region, "geoms", [self.region]))
 
     def loops(self) -> list[np.ndarray]:
@@ -118,6 +124,7 @@ class Geometry:
         return shapely.distance(self.region, shapely.points(points))
 
     def distance_to_boundary(self, points: np.ndarray) -> np.ndarray:
+        """(k,) distance of each of the points (k, 2) from the body's boundary, inside or outside."""
         return shapely.distance(self.region.boundary, shapely.points(points))
 
     def snap_to_circles(self, points: np.ndarray, tol: float) -> np.ndarray:

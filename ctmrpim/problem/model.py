@@ -62,6 +62,7 @@ class PointLoad:
 
 @dataclass(frozen=True)
 class Probe:
+    """A named point (x, y) whose displacement is reported (and compared with the exact solution where given)."""
     name: str
     x: float
     y: float
@@ -79,11 +80,13 @@ class ExactSolution:
     sxy: Field | None = None
 
     def displacement(self, x: np.ndarray, y: np.ndarray) -> np.ndarray | None:
+        """(k, 2) ux, uy at points x, y (k,) each; None unless both are given."""
         if self.ux is None or self.uy is None:
             return None
         return np.c_[self.ux(x, y), self.uy(x, y)]
 
     def stress(self, x: np.ndarray, y: np.ndarray) -> np.ndarray | None:
+        """(k, 3) sxx, syy, sxy at points x, y (k,) each; None unless all three are given."""
         if self.sxx is None or self.syy is None or self.sxy is None:
             return None
         return np.c_[self.sxx(x, y), self.syy(x, y), self.sxy(x, y)]
@@ -91,6 +94,9 @@ class ExactSolution:
 
 @dataclass
 class Problem:
+    """The continuous problem (module docstring): geometry, material (any of :mod:`ctmrpim.materials`), analysis
+    (``linear``, ``quasi-static``, ``strength-reduction``, ``dynamic``, ``explicit``), plane ``stress`` or
+    ``strain``, thickness, gravity, the expressions' parameters, constraints, loads, probes, walls, exact solution."""
     name: str
     geometry: Geometry
     material: LinearElastic
@@ -108,6 +114,7 @@ class Problem:
     exact: ExactSolution | None = None
 
     def D(self) -> np.ndarray:
+        """(3, 3) the material's (small-strain) elasticity matrix in the problem's plane state."""
         return self.material.D(self.plane)
 
     @property

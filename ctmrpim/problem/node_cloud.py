@@ -40,6 +40,7 @@ class NodeSpec:
             raise ProblemError(f"spacing = {self.spacing} must be > 0", key="nodes.spacing")
 
     def as_dict(self) -> dict:
+        """The given one of ``grid`` (as a list), ``spacing`` or ``file``, as ``summary.json`` reports it."""
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in
                 (("grid", self.grid), ("spacing", self.spacing), ("file", self.file)) if v is not None}
 
@@ -129,7 +130,8 @@ def _read_nodes(geometry: Geometry, path: Path) -> np.ndarray:
 
 
 def check_nodes_inside(geometry: Geometry, nodes: np.ndarray, tol: float) -> None:
-    """Every node must lie in the body or within ``tol`` of its boundary."""
+    """Every node of ``nodes`` (n, 2) must lie in the body or within ``tol`` of its boundary, and no two coincide;
+    a ProblemError naming them otherwise."""
     out = np.flatnonzero(geometry.distance_outside(nodes) > tol)
     if len(out):
         first = ", ".join(f"#{i} ({nodes[i, 0]:g}, {nodes[i, 1]:g})" for i in out[:5])

@@ -112,6 +112,7 @@ class Method:
 
     @property
     def polynomial_terms(self) -> int:
+        """m, the number of polynomial terms augmenting the RPIM basis: 3 (linear) or 6 (quadratic)."""
         return POLYNOMIAL_TERMS[self.polynomial]
 
     def scaled(self, d_c: float) -> ScaledMethod:
@@ -122,6 +123,7 @@ class Method:
                             polynomial_terms=self.polynomial_terms, gauss_points=self.gauss_points)
 
     def as_dict(self) -> dict:
+        """The table's settings as ``summary.json`` reports them (``line_spacing`` as a list)."""
         d = asdict(self)
         d["line_spacing"] = list(self.line_spacing)
         return d

@@ -14,15 +14,24 @@ No pore pressure. The slope is given by its ground surface, a polyline y(x) from
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import minimize
+
+if TYPE_CHECKING:
+    from shapely.geometry import Polygon
+
+    from ctmrpim.problem.geometry import Geometry
+    from ctmrpim.problem.model import Problem
 
 SLICES = 100
 
 
 @dataclass
 class SlipCircle:
+    """A slip circle, centre (xc, yc) and radius, with its Bishop factor of safety ``fs`` and the abscissae where
+    its arc meets the ground surface (entry left, exit right)."""
     fs: float
     xc: float
     yc: float
@@ -31,7 +40,7 @@ class SlipCircle:
     x_exit: float
 
 
-def top_surface(body) -> np.ndarray:
+def top_surface(body: Geometry | Polygon) -> np.ndarray:
     """Ground surface (k, 2) of a body (a :class:`ctmrpim.problem.geometry.Geometry` or a shapely polygon):
     the highest boundary point above each vertex abscissa."""
     import shapely
@@ -90,8 +99,8 @@ def bishop(surface: np.ndarray, gamma: float, c: float, phi: float, xc: float, y
 
 def critical_circle(surface: np.ndarray, gamma: float, c: float, phi: float, base: float = -np.inf,
                     grid: int = 24) -> SlipCircle:
-    """The circle of least Bishop factor of safety: a grid over centres above the slope and radii,
-    refined by Nelder-Mead from the best few."""
+    """The circle of least Bishop factor of safety under the ground ``surface`` (k, 2), left to right: a grid
+    over centres above the slope and radii, refined by Nelder-Mead from the best few."""
     x0, x1 = surface[0, 0], surface[-1, 0]
     ytop, ybot = surface[:, 1].max(), surface[:, 1].min()
     height = ytop - min(ybot, base if np.isfinite(base) else ybot)
@@ -121,7 +130,7 @@ def critical_circle(surface: np.ndarray, gamma: float, c: float, phi: float, bas
     return result
 
 
-def problem_factor_of_safety(problem) -> SlipCircle:
+def problem_factor_of_safety(problem: Problem) -> SlipCircle:
     """Bishop's critical circle for a slope Problem: its geometry's ground surface, unit weight
     density x |gravity|, c and phi of its Mohr-Coulomb material, a rigid base at the bottom of the body."""
     gamma = problem.material.density * float(np.hypot(*problem.gravity))

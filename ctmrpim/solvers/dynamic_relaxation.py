@@ -30,6 +30,8 @@ SAFETY = 1.0
 
 @dataclass
 class RelaxationPath:
+    """The outcome of :func:`relax`: at rest or not, the steps run, the final out-of-balance ratio and the
+    recorded history."""
     at_rest: bool
     steps: int
     residual: float                                   # |F_ext - F_int| / |F_ext| at the end
@@ -45,12 +47,13 @@ class RelaxationPath:
 
 
 def max_displacement(U: np.ndarray) -> float:
-    """The largest nodal displacement of interleaved dofs U."""
+    """The largest nodal displacement of interleaved dofs U (2n,)."""
     return float(np.linalg.norm(U.reshape(-1, 2), axis=1).max())
 
 
 def relaxation_mass(system) -> np.ndarray:
-    """Per dof: the fictitious nodal mass (equal for a node's two dofs)."""
+    """(2n,) per dof: the fictitious nodal mass (equal for a node's two dofs) of ``system``, a
+    :class:`~ctmrpim.solvers.plastic_system.PlasticSystem` (not imported: that module imports this one)."""
     K = abs(system.elastic_stiffness())
     rows = np.asarray(K.sum(axis=1)).ravel()          # dofs are interleaved (x, y) per node
     return SAFETY * np.repeat(rows.reshape(-1, 2).max(axis=1), 2)
@@ -58,9 +61,10 @@ def relaxation_mass(system) -> np.ndarray:
 
 def relax(system, material: MohrCoulomb, load_factor: float, settings: Relaxation,
           fixed_values: np.ndarray | None = None) -> RelaxationPath:
-    """Relax the system from its committed state under the loads at ``load_factor`` with ``material``;
-    the state is committed at every step. Prescribed displacements are set at once (to
-    ``load_factor`` times their values unless ``fixed_values`` is given)."""
+    """Relax the ``system`` (a :class:`~ctmrpim.solvers.plastic_system.PlasticSystem`) from its committed state
+    under the loads at ``load_factor`` with ``material``; the state is committed at every step. Prescribed
+    displacements are set at once (to ``load_factor`` times their values unless ``fixed_values``, one per
+    fixed dof, is given)."""
     mass = relaxation_mass(system)
     f_ext = system.external_force(load_factor)
     scale = max(float(np.linalg.norm(f_ext)), 1e-30)

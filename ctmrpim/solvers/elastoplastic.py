@@ -13,7 +13,7 @@ import numpy as np
 
 from ctmrpim.discretisation import assembly
 from ctmrpim.discretisation.boundary_loads import reference_loads
-from ctmrpim.discretisation.configuration import boundary_tags, reference_configuration
+from ctmrpim.discretisation.configuration import BoundaryTags, Configuration, boundary_tags, reference_configuration
 from ctmrpim.discretisation.state_transfer import NodalProjection
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
@@ -23,7 +23,7 @@ from ctmrpim.solvers.plastic_system import PlasticOutput, PlasticSystem, run_ela
 from ctmrpim.timing import Timer
 
 
-def ctm_plastic_system(case: Case, timer: Timer):
+def ctm_plastic_system(case: Case, timer: Timer) -> tuple[PlasticSystem, Configuration, BoundaryTags]:
     """The CTM-RPIM discretisation of a Mohr-Coulomb Case as a :class:`PlasticSystem`, with the
     configuration it was built on and the boundary tags of that configuration."""
     problem = case.problem

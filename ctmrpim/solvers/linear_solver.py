@@ -30,7 +30,8 @@ BANDED_MAX_FRACTION = 0.1   # auto: banded Cholesky when the RCM half-bandwidth 
 
 def solve_constrained(K: sp.csr_matrix, F: np.ndarray, fixed: np.ndarray, values: np.ndarray,
                       solver: str = "superlu") -> np.ndarray:
-    """U with U[fixed] = values and (K U - F)[free] = 0."""
+    """U (2n,) with U[fixed] = values and (K U - F)[free] = 0, for K (2n x 2n) and F (2n,); ``fixed`` (k,) dof
+    indices with ``values`` (k,)."""
     n = K.shape[0]
     U = np.zeros(n)
     U[fixed] = values

@@ -39,14 +39,14 @@ class Anderson:
     (20.9 s), depth 5: 393 iterations (9.3 s). With a matrix that changes every iteration (full Newton)
     the history restarts each time and the step is Newton's."""
 
-    def __init__(self, depth: int):
+    def __init__(self, depth: int) -> None:
         self.depth = depth
         self.x: list[np.ndarray] = []
         self.f: list[np.ndarray] = []
         self.K = None
 
-    def step(self, x: np.ndarray, f: np.ndarray, K) -> np.ndarray:
-        """The increment to add to x."""
+    def step(self, x: np.ndarray, f: np.ndarray, K: sp.spmatrix) -> np.ndarray:
+        """The increment (n_dofs,) to add to the iterate x (n_dofs,), from the plain step f = K^-1 r (n_dofs,)."""
         if self.depth == 0:
             return f
         if K is not self.K:
@@ -66,6 +66,9 @@ class Anderson:
 
 @dataclass
 class LoadPath:
+    """The outcome of :func:`step_loads`: the last converged dofs U (n_dofs,), one history entry per increment
+    tried (load_factor, converged, iterations, and a note or the ``on_converged`` entries), the cut-backs and
+    Newton iterations."""
     U: np.ndarray
     history: list[dict[str, Any]] = field(default_factory=list)
     cutbacks: int = 0

@@ -27,7 +27,6 @@ scikit-fem reference use the same one, with the same material class and the same
 """
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -92,7 +91,7 @@ class PlasticSystem:
     tangent: str = "consistent"             # "consistent" (Newton) or "elastic" (see the module)
     tangents: int = 0                       # tangents built
     factorisations: int = 0                 # LU factorisations (a tangent equal to the last one reuses them)
-    seconds: dict[str, float] = field(default_factory=dict)   # time per phase of the iteration
+    clock: Timer = field(default_factory=Timer)   # seconds per phase of the iterations
 
     def __post_init__(self) -> None:
         self.GT = self.G.T
@@ -106,6 +105,7 @@ class PlasticSystem:
         self._lu = None
 
     def strain_increment(self, U: np.ndarray) -> np.ndarray:
+        """(m, 3) exx, eyy, gxy at the points from the committed dofs to the interleaved dofs U (2n,)."""
         return (self.G @ (U - self.U)).reshape(-1, 4) @ FROM_GRAD.T
 
     def trial_state(self, material: MohrCoulomb, U: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -115,9 +115,11 @@ class PlasticSystem:
         return U.copy(), stress, region, self.plastic_strain + plastic_strain_increment(material, de, stress - self.stress)
 
     def commit(self, material: MohrCoulomb, U: np.ndarray) -> None:
+        """Make the trial state at U (2n,) under ``material`` the committed one."""
         self.U, self.stress, self.region, self.plastic_strain = self.trial_state(material, U)
 
     def external_force(self, load_factor: float) -> np.ndarray:
+        """(2n,) F_ext at ``load_factor``: the loads and gravity, both scaled by it."""
         return self.dead(load_factor) + load_factor * self.body
 
     def elastic_stiffness(self) -> sp.csr_matrix:
@@ -134,65 +136,62 @@ class PlasticSystem:
         return internal_force(self.G, self.stress[:, :3] @ TO_P.T, self.w, self.GT)
 
     def snapshot(self) -> tuple[np.ndarray, ...]:
+        """Copies of the committed (U, stress, region, plastic strain), for :meth:`restore`."""
         return self.U.copy(), self.stress.copy(), self.region.copy(), self.plastic_strain.copy()
 
     def restore(self, state: tuple[np.ndarray, ...]) -> None:
+        """Make a :meth:`snapshot` the committed state again."""
         self.U, self.stress, self.region, self.plastic_strain = (a.copy() for a in state)
 
-    def assemble(self, material: MohrCoulomb, U: np.ndarray, load_factor: float):
-        """(F_ext, F_int, K) at the trial U; K is the elastic stiffness or the consistent tangent."""
-        t0 = time.perf_counter()
-        de = self.strain_increment(U)
-        stress, region = material.update(self.stress, de)
-        t1 = time.perf_counter()
-        f_ext = self.external_force(load_factor)
-        f_int = internal_force(self.G, stress[:, :3] @ TO_P.T, self.w, self.GT)
-        t2 = time.perf_counter()
-        self.elastic_stiffness()
-        if self.tangent == "elastic":
-            if self._K is None:
-                self._K = self._K_elastic
+    def assemble(self, material: MohrCoulomb, U: np.ndarray, load_factor: float
+                 ) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix]:
+        """(F_ext (2n,), F_int (2n,), K (2n x 2n)) at the trial U (2n,); K is the elastic stiffness or the
+        consistent tangent."""
+        with self.clock.measure("return mapping"):
+            de = self.strain_increment(U)
+            stress, region = material.update(self.stress, de)
+        with self.clock.measure("internal force"):
+            f_ext = self.external_force(load_factor)
+            f_int = internal_force(self.G, stress[:, :3] @ TO_P.T, self.w, self.GT)
+        with self.clock.measure("tangent"):
+            self.elastic_stiffness()
+            if self.tangent == "elastic":
+                if self._K is None:
+                    self._K = self._K_elastic
+                    self.tangents += 1
+            else:
+                # K = K_elastic + the plastic points' correction: its product runs over those points only
+                plastic = np.flatnonzero(region != ELASTIC)
+                self._K = self._K_elastic          # its factors are kept while no point is plastic
+                if len(plastic):
+                    dA = TO_P[None] @ (material.tangent(self.stress[plastic], de[plastic])
+                                       - material.D("strain")[None]) @ FROM_GRAD[None]
+                    Gp = block_rows(self.G, plastic)
+                    self._K = self._K_elastic + tangent(Gp, dA, self.w[plastic], Gp.T)
                 self.tangents += 1
-        else:
-            # K = K_elastic + the plastic points' correction: its product runs over those points only
-            plastic = np.flatnonzero(region != ELASTIC)
-            self._K = self._K_elastic          # its factors are kept while no point is plastic
-            if len(plastic):
-                dA = TO_P[None] @ (material.tangent(self.stress[plastic], de[plastic])
-                                   - material.D("strain")[None]) @ FROM_GRAD[None]
-                Gp = block_rows(self.G, plastic)
-                self._K = self._K_elastic + tangent(Gp, dA, self.w[plastic], Gp.T)
-            self.tangents += 1
-        self._clock("return mapping", t1 - t0)
-        self._clock("internal force", t2 - t1)
-        self._clock("tangent", time.perf_counter() - t2)
         return f_ext, f_int, self._K
 
     def solve(self, K: sp.csr_matrix, residual: np.ndarray) -> np.ndarray:
-        """du with du = 0 at the fixed dofs, reusing the LU factors of K while K is unchanged."""
-        t0 = time.perf_counter()
-        if self._lu is None or self._lu[0] is not K:
-            Kff = K[self.free][:, self.free].tocsc()
-            try:
-                self._lu = (K, spla.splu(Kff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=PIVOT_THRESHOLD,
-                                         options={"SymmetricMode": True}))
-            except RuntimeError as exc:
-                raise ProblemError(f"the tangent stiffness is singular ({exc})") from None
-            self.factorisations += 1
-        t1 = time.perf_counter()
-        du = np.zeros_like(residual)
-        du[self.free] = self._lu[1].solve(residual[self.free])
-        self._clock("factorisation", t1 - t0)
-        self._clock("substitution", time.perf_counter() - t1)
+        """du (2n,) with K du = ``residual`` (2n,) at the free dofs and du = 0 at the fixed ones, reusing the LU
+        factors of K (2n x 2n) while K is unchanged."""
+        with self.clock.measure("factorisation"):
+            if self._lu is None or self._lu[0] is not K:
+                Kff = K[self.free][:, self.free].tocsc()
+                try:
+                    self._lu = (K, spla.splu(Kff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=PIVOT_THRESHOLD,
+                                             options={"SymmetricMode": True}))
+                except RuntimeError as exc:
+                    raise ProblemError(f"the tangent stiffness is singular ({exc})") from None
+                self.factorisations += 1
+        with self.clock.measure("substitution"):
+            du = np.zeros_like(residual)
+            du[self.free] = self._lu[1].solve(residual[self.free])
         return du
 
     def iteration_counts(self) -> dict[str, Any]:
         """Tangents built, factorisations and the seconds spent in each phase of the iterations."""
         return {"tangents": self.tangents, "factorisations": self.factorisations,
-                "iteration_seconds": {k: round(v, 3) for k, v in self.seconds.items()}}
-
-    def _clock(self, phase: str, seconds: float) -> None:
-        self.seconds[phase] = self.seconds.get(phase, 0.0) + seconds
+                "iteration_seconds": {k: round(v, 3) for k, v in self.clock.phases.items()}}
 
     def run(self, loading: Loading, material_at: Callable[[float], MohrCoulomb],
             load_at: Callable[[float], float], on_converged: Callable[[float, np.ndarray], dict[str, Any]],

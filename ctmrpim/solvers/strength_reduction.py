@@ -32,7 +32,6 @@ value through the sweep executor so the levels run in parallel.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, replace
 from typing import Any, Callable
 
@@ -40,9 +39,11 @@ import numpy as np
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
-from ctmrpim.problem.settings import Relaxation, StrengthReduction
+from ctmrpim.problem.case import Case
+from ctmrpim.problem.settings import Loading, Relaxation, StrengthReduction
 from ctmrpim.result import Result
 from ctmrpim.solvers.dynamic_relaxation import max_displacement, relax
+from ctmrpim.timing import Timer
 
 CRITERION = {"newton": "non-convergence: the equilibrium iteration (loading.tangent: Newton, or the elastic "
                        "stiffness with Anderson mixing) did not reach the residual and displacement tolerance within "
@@ -79,9 +80,12 @@ class Level:
 
     @property
     def max_displacement(self) -> float:
+        """The largest nodal displacement of the level's state."""
         return max_displacement(self.state[0])
 
     def record(self) -> dict[str, Any]:
+        """The level as an entry of the result's history: srf, stable, iterations, cut-backs, max displacement,
+        seconds, and the criterion and displacement history where there are."""
         return {"srf": self.srf, "stable": self.stable, "iterations": self.iterations, "cutbacks": self.cutbacks,
                 "max_displacement": self.max_displacement, "seconds": round(self.seconds, 3),
                 **({"criterion": self.criterion} if self.criterion else {}),
@@ -90,10 +94,10 @@ class Level:
 
 def _relax_level(system, relaxation: Relaxation, material: MohrCoulomb, srf: float, fixed_values=None) -> Level:
     """Dynamic relaxation from the committed state with ``material`` under the full loads."""
-    t0 = time.perf_counter()
+    timer = Timer()
     path = relax(system, material, 1.0, relaxation, fixed_values)
     history = [[h["step"], h["max_displacement"]] for h in path.history]
-    seconds = time.perf_counter() - t0
+    seconds = timer.elapsed()
     growth = path.growth()
     if path.at_rest or growth <= SETTLED_GROWTH:
         note = "" if path.at_rest else (f"not at rest (out-of-balance {path.residual:.1e}) but settled: the "
@@ -108,10 +112,10 @@ def _level(system, loading, material_at, load_at, srf_at: Callable[[float], floa
     """Run the path t = 0..1 from the committed state; returns the level at t = 1 (stable, or failed
     at the sub-step that did not converge) and, for a failed level whose cut-back sub-steps got part of
     the way, the stable level reached (the system is left there)."""
-    t0 = time.perf_counter()
+    timer = Timer()
     path = system.run(loading, material_at, load_at, lambda t, U: {}, fixed_values=fixed_values,
                       stop_on_failure=True)
-    seconds = time.perf_counter() - t0
+    seconds = timer.elapsed()
     if path.failed_at is None:
         return Level(srf_at(1.0), True, path.newton_iterations, path.cutbacks, seconds, system.snapshot()), None
     failed = Level(srf_at(path.failed_at), False, path.newton_iterations, path.cutbacks, seconds,
@@ -123,20 +127,23 @@ def _level(system, loading, material_at, load_at, srf_at: Callable[[float], floa
                          "reached by the cut-back sub-steps of the next level")
 
 
-def gravity_level(system, loading, material: MohrCoulomb, srf: float, relaxation: Relaxation | None = None) -> Level:
+def gravity_level(system, loading: Loading, material: MohrCoulomb, srf: float,
+                  relaxation: Relaxation | None = None) -> Level:
     """Loads ramped from zero on the reduced material (the first stage of a search; one sweep level);
-    with ``relaxation``, applied at once and relaxed (the paper's way)."""
+    with ``relaxation``, applied at once and relaxed (the paper's way). ``system`` is a
+    :class:`~ctmrpim.solvers.plastic_system.PlasticSystem` (not imported: that module imports this one)."""
     m = reduced(material, srf)
     if relaxation is not None:
         return _relax_level(system, relaxation, m, srf)
     return _level(system, loading, lambda t: m, lambda t: t, lambda t: srf)[0]
 
 
-def search(system, loading, material: MohrCoulomb, settings: StrengthReduction,
+def search(system, loading: Loading, material: MohrCoulomb, settings: StrengthReduction,
            progress: Callable[[Level], None] = lambda level: None,
            relaxation: Relaxation | None = None) -> tuple[list[Level], Level, Level]:
     """Bracket and bisect the factor of safety; returns (levels in order, last stable, first failed
-    of the final bracket). The system is left in the last stable state."""
+    of the final bracket). The ``system`` (a :class:`~ctmrpim.solvers.plastic_system.PlasticSystem`) is left
+    in the last stable state."""
     first = gravity_level(system, loading, material, settings.start, relaxation)
     progress(first)
     levels = [first]
@@ -173,10 +180,11 @@ def search(system, loading, material: MohrCoulomb, settings: StrengthReduction,
     return levels, stable, failed
 
 
-def sweep(system, loading, material: MohrCoulomb, values: tuple[float, ...],
+def sweep(system, loading: Loading, material: MohrCoulomb, values: tuple[float, ...],
           progress: Callable[[Level], None] = lambda level: None, relaxation: Relaxation | None = None
           ) -> list[Level]:
-    """Each SRF on its own from zero, gravity at the reduced strength."""
+    """Each SRF of ``values`` on its own from ``system``'s committed state (a
+    :class:`~ctmrpim.solvers.plastic_system.PlasticSystem`), gravity at the reduced strength."""
     start = system.snapshot()
     levels = []
     for srf in values:
@@ -194,20 +202,22 @@ def bracket(levels: list[Level]) -> tuple[float | None, float | None]:
     return stable, failed
 
 
-def solve_strength_reduction(case, system, out, base: Result,
+def solve_strength_reduction(case: Case, system, out, base: Result,
                              progress: Callable[[Level], None] = lambda level: None) -> Result:
-    """Run the ``[strength-reduction]`` of ``case`` on ``system`` (any discretisation, reported through
-    ``out``, a :class:`ctmrpim.solvers.plastic_system.PlasticOutput`) and fill ``base`` with the last stable
-    state, the levels in the history and the series, and the factor of safety as a bracket."""
+    """Run the ``[strength-reduction]`` of ``case`` on ``system`` (a
+    :class:`ctmrpim.solvers.plastic_system.PlasticSystem` of any discretisation, reported through ``out``, a
+    :class:`ctmrpim.solvers.plastic_system.PlasticOutput`; not imported: that module imports this one) and fill
+    ``base`` with the last stable state, the levels in the history and the series, and the factor of safety as
+    a bracket."""
     settings: StrengthReduction = case.strength_reduction
     material = case.problem.material
     relaxation = case.relaxation if settings.solver == "dynamic-relaxation" else None
-    t0 = time.perf_counter()
+    timer = Timer()
     if settings.values:
         levels = sweep(system, case.loading, material, settings.values, progress, relaxation)
     else:
         levels, _, _ = search(system, case.loading, material, settings, progress, relaxation)
-    seconds = time.perf_counter() - t0
+    seconds = timer.elapsed()
     stable, failed = bracket(levels)
     series = []
     for lv in levels:

@@ -70,7 +70,7 @@ AREA_JUMP = 0.02
 REFERENCE_NEIGHBOURS = 2.0
 
 
-def stress_update(case: Case):
+def stress_update(case: Case) -> HypoelasticUpdate | LeftCauchyGreenUpdate:
     """The objective update of the case's material: neo-Hookean by its left Cauchy-Green tensor,
     linear elasticity as a Hughes-Winget rate law."""
     material, problem = case.problem.material, case.problem
@@ -100,6 +100,7 @@ class TractionTags:
     d0: np.ndarray
 
     def positions(self, x: np.ndarray) -> np.ndarray:
+        """(t, 2) where the tagged points are on their segments with the nodes at ``x`` (n, 2)."""
         a, b = x[self.ends[:, 0]], x[self.ends[:, 1]]
         return a + self.fraction[:, None] * (b - a)
 
@@ -108,8 +109,9 @@ class AdaptiveBody:
     """The node cloud in its current configuration with everything built on it, and the state at its
     integration points. ``trial`` evaluates an increment, ``commit`` accepts it and rebuilds."""
 
-    def __init__(self, case: Case, X: np.ndarray, lengths: ScaledMethod, update, traction: TractionTags,
-                 material_points: np.ndarray, point_forces: np.ndarray, timer: Timer):
+    def __init__(self, case: Case, X: np.ndarray, lengths: ScaledMethod,
+                 update: HypoelasticUpdate | LeftCauchyGreenUpdate, traction: TractionTags,
+                 material_points: np.ndarray, point_forces: np.ndarray, timer: Timer) -> None:
         self.case, self.X, self.lengths, self.update, self.traction, self.timer = (case, X, lengths, update, traction,
                                                                                  timer)
         self.x = X.copy()
@@ -205,6 +207,7 @@ class AdaptiveBody:
 
     @property
     def boundary(self) -> Boundary:
+        """The tracked boundary of the current configuration."""
         return self.conf.boundary
 
     @property
@@ -219,10 +222,13 @@ class AdaptiveBody:
 
     @property
     def sf(self) -> ShapeFunctions:
+        """The RPIM shape functions at the current integration points, (m, n) sparse rows."""
         return self.conf.sf
 
     # -- increments ----------------------------------------------------------------------------------
     def relative_gradient(self, du: np.ndarray) -> np.ndarray:
+        """(m, 2, 2) f = I + grad du at the points, of the increment du (2n,) (interleaved) from the current
+        configuration."""
         return np.eye(2)[None] + (self.G @ du).reshape(-1, 2, 2)
 
     def trial(self, U: np.ndarray, factor: float) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix]:
@@ -288,9 +294,11 @@ class AdaptiveBody:
 
     @property
     def u(self) -> np.ndarray:
+        """(n, 2) the total nodal displacements."""
         return self.U.reshape(-1, 2).copy()
 
     def stress_nodes(self) -> np.ndarray:
+        """(n, 3) Cauchy stress sxx, syy, sxy at the nodes, of the state projected to them."""
         return self.update.cauchy(self.nodal_state)
 
 

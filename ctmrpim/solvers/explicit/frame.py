@@ -78,7 +78,7 @@ class FrameBuilder:
 
 
 def extrapolating_points(frame: Configuration, d_c: float) -> np.ndarray:
-    """Indices of the points of ``frame`` whose shape-function gradients exceed GRADIENT_LIMIT / d_c: they
+    """(k,) indices of the points of ``frame`` whose shape-function gradients exceed GRADIENT_LIMIT / d_c: they
     extrapolate from a support on one side, where the nodes around them have left the body."""
     dx, dy = frame.sf.dNdx, frame.sf.dNdy
     size = np.sqrt(np.asarray(dx.multiply(dx).max(axis=1).todense()).ravel()

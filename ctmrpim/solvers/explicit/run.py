@@ -79,7 +79,7 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
     (n,) lumped, ``weight`` (n, 2) m g, ``movable`` (n, 2) the free dofs; the evolving state is
     :class:`~ctmrpim.solvers.explicit.state.RunState`'s."""
 
-    def __init__(self, case: Case, out: Path, key: str):
+    def __init__(self, case: Case, out: Path, key: str) -> None:
         problem = case.problem
         if not isinstance(problem.material, MohrCoulomb):
             raise ProblemError("explicit dynamics is implemented for model = \"mohr-coulomb\"", key="material.model")

@@ -53,7 +53,8 @@ def stable_step(omega: float, cfl: float, beta: float = 0.0) -> float:
 
 
 def checkerboard(points: np.ndarray, d_c: float) -> np.ndarray:
-    """A start vector rich in the highest mode: neighbouring nodes move in opposite directions."""
+    """(n, 2) a start vector rich in the highest mode at nodes ``points`` (n, 2): neighbouring nodes move in
+    opposite directions."""
     parity = (np.floor(points[:, 0] / d_c + 0.5) + np.floor(points[:, 1] / d_c + 0.5)) % 2
     sign = 1.0 - 2.0 * parity
     return np.c_[sign, -sign] + 1e-3 * np.c_[np.cos(points[:, 0] / d_c), np.sin(points[:, 1] / d_c)]
