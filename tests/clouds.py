@@ -1,4 +1,4 @@
-"""Canonical node clouds and geometries reused by the unit tests (cf. meshio's test helpers)."""
+"""Canonical node clouds, geometries and overrides reused by the tests (cf. meshio's test helpers)."""
 from __future__ import annotations
 
 import numpy as np
@@ -29,3 +29,6 @@ def cloud(name: str, jitter: float = 0.0, seed: int = 0) -> tuple[Geometry, np.n
         nodes[interior] += rng.uniform(-jitter * h, jitter * h, (interior.sum(), 2))
         assert shapely.contains_xy(geometry.region, nodes[interior, 0], nodes[interior, 1]).all()
     return geometry, nodes, mean_node_spacing(geometry.area, len(nodes))
+
+#: overrides of the column-collapse benchmark for a quick explicit run: its coarsest cloud
+QUICK_COLUMN = ["nodes.grid=[16, 9]", "method.alpha=2.0"]

@@ -1,4 +1,5 @@
-"""RPIM shape functions (Eqs. 25-34): the identities they must satisfy, and an independent oracle."""
+"""RPIM shape functions (Eqs. 25-34): the identities they must satisfy, an independent oracle, supports widened
+to a minimum node count and singular points dropped."""
 from __future__ import annotations
 
 import numpy as np
@@ -90,3 +91,20 @@ def test_collinear_support_is_singular_error() -> None:
     nodes = np.c_[np.linspace(0, 1, 10), np.zeros(10)]
     with pytest.raises(ProblemError, match="singular"):
         shape_functions(nodes, np.array([[0.5, 0.0]]), 0.5, 5.0, 3, 0.1)
+
+
+def test_supports_widen_to_min_nodes_and_singular_points_are_dropped():
+    from ctmrpim.discretisation.rpim import shape_functions
+    rng = np.random.default_rng(0)
+    nodes = rng.random((60, 2))
+    far = np.array([[3.0, 3.0]])                   # no node within the radius
+    with pytest.raises(ProblemError):
+        shape_functions(nodes, far, support_radius=0.3, eta=5.0, polynomial_terms=3, scale=0.1)
+    sf = shape_functions(nodes, far, support_radius=0.3, eta=5.0, polynomial_terms=3, scale=0.1, min_nodes=12)
+    assert sf.support_sizes[0] == 12
+    assert sf.N.sum() == pytest.approx(1.0, abs=1e-6)
+    # a point whose support nodes are collinear: dropped (empty row) instead of an error
+    line = np.c_[np.linspace(0, 1, 8), np.zeros(8)]
+    sf = shape_functions(line, np.array([[0.5, 0.01]]), support_radius=2.0, eta=5.0, polynomial_terms=3,
+                         scale=0.1, drop_singular=True)
+    assert list(sf.dropped) == [0] and sf.N.nnz == 0

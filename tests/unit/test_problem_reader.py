@@ -1,18 +1,16 @@
-"""Problem files: the cantilever benchmark, --set overrides, defaults, geometry and node placement."""
+"""Reading problem files (ctmrpim.problem.reader): the cantilever benchmark, --set overrides, defaults applied and
+recorded, parameters in order, nodes from a CSV file."""
 from __future__ import annotations
 
-import math
 import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.spatial import cKDTree
 
 from ctmrpim import benchmarks
 from ctmrpim.errors import ProblemError
-from ctmrpim.problem.geometry import CIRCLE_SAGITTA, Geometry, Shape, circle_segments
-from ctmrpim.problem.node_cloud import NodeSpec, check_nodes_inside, make_nodes
+from ctmrpim.problem.node_cloud import NodeSpec, make_nodes
 from ctmrpim.problem.reader import apply_overrides, read_case
 from ctmrpim.problem.settings import Method
 
@@ -131,84 +129,9 @@ def test_parameters_are_evaluated_in_order(tmp_path: Path) -> None:
 
 
 # -- geometry -----------------------------------------------------------------------------------------
-def test_circle_polygon_sagitta() -> None:
-    cx, cy, r = 1.0, -2.0, 3.0
-    poly = Shape("circle", (cx, cy, r)).polygon()
-    v = np.asarray(poly.exterior.coords)[:-1]
-    assert len(v) == circle_segments()
-    np.testing.assert_allclose(np.hypot(v[:, 0] - cx, v[:, 1] - cy), r, rtol=1e-14)   # vertices on the arc
-    mid = 0.5 * (v + np.roll(v, -1, axis=0))
-    sagitta = r - np.hypot(mid[:, 0] - cx, mid[:, 1] - cy)       # chord midpoint to arc
-    assert sagitta.max() <= CIRCLE_SAGITTA * r
-    assert sagitta.max() > 0.5 * CIRCLE_SAGITTA * r             # and not needlessly fine
-
-
-def test_rectangle_minus_circle_area() -> None:
-    a, b, r = 10.0, 8.0, 1.0
-    g = Geometry(add=[Shape("rectangle", (0.0, 0.0, a, b))], subtract=[Shape("circle", (4.0, 3.0, r))])
-    exact = a * b - math.pi * r**2
-    # the polygon misses (4/3) pi r^2 CIRCLE_SAGITTA of the hole at most (segments of height <= sagitta)
-    assert 0 <= g.area - exact <= 4 / 3 * math.pi * r**2 * CIRCLE_SAGITTA
-    assert g.area == pytest.approx(exact, rel=1e-6)
-    assert len(g.loops()) == 2 and g.circles == [(4.0, 3.0, r)] and not g.is_rectangle()
-
-
-def test_add_and_subtract() -> None:
-    # an L shape from two overlapping rectangles, a triangle notch cut from it
-    g = Geometry(add=[Shape("rectangle", (0, 0, 4, 1)), Shape("rectangle", (0, 0, 1, 3))],
-                 subtract=[Shape("polygon", ((3, 0), (4, 0), (4, 1)))])
-    assert g.area == pytest.approx(4 + 2 - 0.5, rel=1e-15)
-    assert g.bounds == (0.0, 0.0, 4.0, 3.0) and len(g.loops()) == 1
-    # two separate parts stay two parts
-    two = Geometry(add=[Shape("rectangle", (0, 0, 1, 1)), Shape("rectangle", (2, 0, 3, 1))])
-    assert len(two.polygons) == 2 and two.area == 2.0
-
-
-def test_boundary_loops_keep_the_body_on_the_left() -> None:
-    g = Geometry(add=[Shape("rectangle", (0, 0, 4, 4))], subtract=[Shape("circle", (2, 2, 1))])
-    outer, hole = g.loops()
-
-    def signed_area(p: np.ndarray) -> float:
-        return 0.5 * float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
-    assert signed_area(outer) == pytest.approx(16.0) and signed_area(hole) < 0
 
 
 # -- nodes ----------------------------------------------------------------------------------------------
-def test_grid_on_a_rectangle_is_the_tensor_grid() -> None:
-    case = benchmarks.load("cantilever", ["nodes.grid=[17,5]"])
-    nodes = make_nodes(case.problem.geometry, case.nodes)
-    assert nodes.shape == (85, 2)
-    assert np.unique(nodes[:, 0]).tolist() == np.linspace(0, 48, 17).tolist()
-    assert np.unique(nodes[:, 1]).tolist() == np.linspace(-6, 6, 5).tolist()
-
-
-@pytest.mark.parametrize("h", [0.5, 0.25])
-def test_spacing_on_a_plate_with_a_hole(h: float) -> None:
-    r = 1.0
-    g = Geometry(add=[Shape("rectangle", (-4.0, -4.0, 4.0, 4.0))], subtract=[Shape("circle", (0.0, 0.0, r))])
-    nodes = make_nodes(g, NodeSpec(spacing=h))
-    assert np.all(g.distance_outside(nodes) == 0.0)          # inside the body or on its boundary
-    check_nodes_inside(g, nodes, tol=1e-12)                  # and no two coincide
-    d = np.hypot(nodes[:, 0], nodes[:, 1])
-    on_hole = d < r + 0.1 * h
-    assert abs(on_hole.sum() - 2 * math.pi * r / h) <= 1
-    assert np.abs(d[on_hole] - r).max() < 1e-12 * r          # exactly on the true arc, not on a chord
-    # the interior grid keeps clear of the boundary nodes: no clumps
-    gap, _ = cKDTree(nodes).query(nodes, k=2)
-    assert gap[:, 1].min() > 0.4 * h
-    assert len(nodes) > g.area / h**2
-
-
-def test_boundary_nodes_on_a_large_arc_lie_on_it() -> None:
-    """A spacing far below the radius: the sagitta (1e-5 r), not the spacing, bounds how far off the
-    arc the polygon's points are, and the snapping must reach that far (it once used 1e-3 h)."""
-    r, h = 1.0, 0.002
-    g = Geometry(add=[Shape("rectangle", (0.0, 0.0, 0.1, 0.1))], subtract=[Shape("circle", (1.05, 0.05, r))])
-    nodes = make_nodes(g, NodeSpec(spacing=h))
-    d = np.hypot(nodes[:, 0] - 1.05, nodes[:, 1] - 0.05)
-    on_arc = d < r + 0.1 * h
-    assert on_arc.sum() > 40
-    assert np.abs(d[on_arc] - r).max() < 1e-12 * r
 
 
 def test_nodes_from_csv(tmp_path: Path) -> None:

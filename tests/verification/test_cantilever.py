@@ -13,10 +13,9 @@ GRIDS = ((17, 5), (33, 9), (65, 17))
 
 
 @pytest.fixture(scope="module")
-def solved() -> dict[tuple[int, int], Result]:
-    return {g: solve_ctmrpim(benchmarks.load("cantilever", [f"nodes.grid=[{g[0]}, {g[1]}]"])) for g in GRIDS}
-
-
+def solved(solutions) -> dict[tuple[int, int], Result]:
+    """Each grid solved once for the run (shared with the command-line tests and the README's example)."""
+    return {g: solutions("cantilever", [f"nodes.grid=[{g[0]}, {g[1]}]"]) for g in GRIDS}
 
 def test_tip_error_33x9(solved) -> None:
     check("cantilever-ctmrpim-33x9-tip", solved[33, 9].errors["probes"]["tip"]["uy"])

@@ -12,15 +12,15 @@ from ctmrpim.errors import ProblemError
 from ctmrpim.methods import solve
 
 
-def test_self_weight_ctmrpim_and_fem() -> None:
+def test_self_weight_ctmrpim_and_fem(solutions) -> None:
     case = benchmarks.load("self-weight")
-    check("self-weight-ctmrpim-top", solve(case).errors["probes"]["top"]["uy"])
+    check("self-weight-ctmrpim-top", solutions(case).errors["probes"]["top"]["uy"])
     check("self-weight-fem-p2-top", solve(case, "fem", "p2").errors["probes"]["top"]["uy"])
 
 
-def test_mohr_coulomb_column_under_gravity_stays_elastic_and_matches() -> None:
+def test_mohr_coulomb_column_under_gravity_stays_elastic_and_matches(solutions) -> None:
     """A strong Mohr-Coulomb column takes the same K0 state as the linear solve, in one increment."""
-    elastic = solve(benchmarks.load("self-weight"))
+    elastic = solutions("self-weight")
     case = benchmarks.load("self-weight", ['problem.analysis="quasi-static"', 'material.model="mohr-coulomb"',
                                            "material.c=1e7", "material.phi=30", "loading.steps=1"])
     plastic = solve(case)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = ("ctmrpim", "reference_fem", "studies")
 #: the meshfree method's discretisation and solvers, which the finite-element reference must not use
 MESHFREE = ("ctmrpim.discretisation", "ctmrpim.solvers.linear_static", "ctmrpim.solvers.total_lagrangian",

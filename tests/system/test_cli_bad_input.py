@@ -1,21 +1,18 @@
-"""Bad input through the real command line: exit status 2, one line naming file, key and reason, no
-traceback, nothing written (README: "Bad input ends with one line naming the file, key and reason").
+"""Bad input through the command line, in-process (``ctmrpim.cli.main``): exit status 2, one line naming
+file, key and reason, no traceback, nothing written (README: "Bad input ends with one line naming the file,
+key and reason"). The console script's own exit status is checked in test_cli.py.
 
-Every case is a small variation of a valid 10 x 2 cantilever-like problem. The subprocesses of all
-cases are started together by one module fixture (they are independent), then checked one by one.
+Every case is a small variation of a valid 10 x 2 cantilever-like problem.
 """
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
 
-SCRIPT = Path(sys.executable).with_name("ctmrpim")
+from ctmrpim.cli import main
 
 BASE = """\
 [problem]
@@ -130,42 +127,38 @@ CASES: dict[str, Case] = {
 
 @dataclass
 class Outcome:
-    proc: subprocess.CompletedProcess
+    code: int              # main's return value: the exit status
+    stdout: str
+    stderr: str
     folder: Path
     file: Path
 
 
-def _run(name: str, case: Case, folder: Path) -> Outcome:
+def _run(case: Case, folder: Path, capsys, monkeypatch) -> Outcome:
     folder.mkdir()
     file = folder / "problem.toml"
     if case.toml is not None:
         file.write_text(case.toml)
     for fname, text in case.files.items():
         (folder / fname).write_text(text)
-    cmd = [str(SCRIPT)] if SCRIPT.exists() else [sys.executable, "-m", "ctmrpim.cli"]
     args = ["run", case.target.format(file=file), "--out", str(folder / "out"),
             *(a.format(file=file) for a in case.args)]
-    proc = subprocess.run([*cmd, *args], cwd=folder, capture_output=True, text=True, timeout=120)
-    return Outcome(proc, folder, file)
-
-
-@pytest.fixture(scope="module")
-def outcomes(tmp_path_factory) -> dict[str, Outcome]:
-    root = tmp_path_factory.mktemp("bad")
-    with ThreadPoolExecutor(max_workers=4) as pool:
-        futures = {name: pool.submit(_run, name, case, root / name) for name, case in CASES.items()}
-        return {name: f.result() for name, f in futures.items()}
+    monkeypatch.chdir(folder)
+    capsys.readouterr()
+    code = main(args)
+    out, err = capsys.readouterr()
+    return Outcome(code, out, err, folder, file)
 
 
 @pytest.mark.parametrize("name", list(CASES))
-def test_bad_input(outcomes, name: str) -> None:
-    case, out = CASES[name], outcomes[name]
-    proc = out.proc
-    assert "Traceback" not in proc.stdout + proc.stderr, proc.stderr
-    assert proc.returncode == 2, proc.stdout + proc.stderr
-    assert proc.stdout == ""
-    lines = proc.stderr.splitlines()
-    assert len(lines) == 1, proc.stderr
+def test_bad_input(tmp_path: Path, capsys, monkeypatch, name: str) -> None:
+    case = CASES[name]
+    out = _run(case, tmp_path / name, capsys, monkeypatch)
+    assert "Traceback" not in out.stdout + out.stderr, out.stderr
+    assert out.code == 2, out.stdout + out.stderr
+    assert out.stdout == ""
+    lines = out.stderr.splitlines()
+    assert len(lines) == 1, out.stderr
     line = lines[0]
     assert line.startswith("ctmrpim: error: "), line
     if case.names_file:
@@ -179,12 +172,11 @@ def test_bad_input(outcomes, name: str) -> None:
     assert not (out.folder / "HACKED").exists()
 
 
-def test_eta_near_an_even_integer_warns_but_runs(tmp_path: Path) -> None:
-    out = _run("eta-near-even", Case(BASE + "\n[method]\neta = 4.05\n", []), tmp_path / "case")
-    proc = out.proc
-    assert proc.returncode == 0, proc.stderr
-    assert "Traceback" not in proc.stdout + proc.stderr
-    lines = proc.stderr.splitlines()
+def test_eta_near_an_even_integer_warns_but_runs(tmp_path: Path, capsys, monkeypatch) -> None:
+    out = _run(Case(BASE + "\n[method]\neta = 4.05\n", []), tmp_path / "case", capsys, monkeypatch)
+    assert out.code == 0, out.stderr
+    assert "Traceback" not in out.stdout + out.stderr
+    lines = out.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith("ctmrpim: warning: method.eta = 4.05 is close to the even integer 4")
     summary = json.loads((out.folder / "out" / "summary.json").read_text())
     assert summary["parameters"]["method"]["eta"] == 4.05

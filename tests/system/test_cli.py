@@ -1,4 +1,6 @@
-"""The real command line, run in a subprocess: list, run (CTM-RPIM and FEM), summary.json, result.vtu."""
+"""The command line: the installed console script in a subprocess (list, run, its exit status, ``python -m
+ctmrpim.cli``), and ``ctmrpim.cli.main`` in-process for the rest (the FEM solver, --set, --quiet, the default
+folder); summary.json and result.vtu against the Python API's result of the same problem."""
 from __future__ import annotations
 
 import json
@@ -11,9 +13,9 @@ import meshio
 import numpy as np
 import pytest
 
-from ctmrpim import benchmarks
+from ctmrpim import benchmarks, methods
+from ctmrpim.cli import main
 from ctmrpim.result import Result
-from ctmrpim.solvers.linear_static import solve_ctmrpim
 from studies import tolerances
 
 SCRIPT = Path(sys.executable).with_name("ctmrpim")   # the console script of the environment under test
@@ -39,9 +41,26 @@ def run(tmp_path_factory) -> tuple[subprocess.CompletedProcess, Path, dict]:
 
 
 @pytest.fixture(scope="module")
-def api() -> Result:
+def api(solutions) -> Result:
     """The same problem solved through the Python API, in this process."""
-    return solve_ctmrpim(benchmarks.load("cantilever"))
+    return solutions("cantilever")
+
+
+@pytest.fixture
+def in_process(solutions, capsys, monkeypatch, tmp_path):
+    """``ctmrpim ARGS`` run by ``ctmrpim.cli.main`` in ``tmp_path``: (exit status, stdout, stderr); its solves
+    are shared with the other tests of the run."""
+    monkeypatch.setattr(methods, "solve", solutions.solve)
+    monkeypatch.chdir(tmp_path)
+
+    def call(*args: str) -> tuple[int, str, str]:
+        capsys.readouterr()
+        code = main(list(args))
+        out, err = capsys.readouterr()
+        assert code == 0, err
+        assert "Traceback" not in out + err
+        return code, out, err
+    return call
 
 
 def test_list(tmp_path: Path) -> None:
@@ -144,10 +163,9 @@ def test_vtu_round_trip(run, api) -> None:
     np.testing.assert_allclose(np.hypot(*(ends[:, 1] - ends[:, 0]).T), 1.5, rtol=1e-12)   # 48/32 = 12/8
 
 
-def test_fem_q1(tmp_path: Path, run) -> None:
-    proc = completed(ctmrpim("run", "cantilever", "--solver", "fem", "--element", "q1", "--out", str(tmp_path / "o"),
-                             cwd=tmp_path))
-    assert proc.stdout.startswith("cantilever (fem-q1): 297 nodes")
+def test_fem_q1(tmp_path: Path, run, in_process) -> None:
+    _, stdout, _ = in_process("run", "cantilever", "--solver", "fem", "--element", "q1", "--out", str(tmp_path / "o"))
+    assert stdout.startswith("cantilever (fem-q1): 297 nodes")
     assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["result.vtu", "summary.json"]
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert s["method"] == "fem-q1" and s["parameters"]["derived"]["element"] == "q1"
@@ -160,9 +178,9 @@ def test_fem_q1(tmp_path: Path, run) -> None:
     assert mesh.point_data["u"].shape == (297, 3) and mesh.point_data["stress"].shape == (297, 3)
 
 
-def test_set_grid_quiet_and_default_folder(tmp_path: Path) -> None:
-    proc = completed(ctmrpim("run", "cantilever", "--set", "nodes.grid=[17,5]", "--quiet", cwd=tmp_path))
-    assert proc.stdout == "" and proc.stderr == ""
+def test_set_grid_quiet_and_default_folder(tmp_path: Path, in_process) -> None:
+    _, stdout, stderr = in_process("run", "cantilever", "--set", "nodes.grid=[17,5]", "--quiet")
+    assert stdout == "" and stderr == ""
     out = tmp_path / "runs" / "cantilever"           # the default output folder
     s = json.loads((out / "summary.json").read_text())
     assert s["counts"]["nodes"] == 85 and s["parameters"]["nodes"] == {"grid": [17, 5]}
@@ -173,3 +191,12 @@ def test_python_dash_m_matches_the_script(tmp_path: Path) -> None:
     proc = subprocess.run([sys.executable, "-m", "ctmrpim.cli", "list"], cwd=tmp_path, capture_output=True,
                           text=True, timeout=60)
     assert proc.returncode == 0 and proc.stdout == ctmrpim("list", cwd=tmp_path).stdout
+
+
+def test_console_script_exits_2_on_bad_input(tmp_path: Path) -> None:
+    """The console script's exit status is main's: 2 for bad input, one line, nothing written (every kind
+    of bad input is in test_cli_bad_input.py, in-process)."""
+    proc = ctmrpim("run", "cantilevr", "--out", str(tmp_path / "out"), cwd=tmp_path)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [proc.stderr.strip()] and "did you mean 'cantilever'?" in proc.stderr
+    assert "Traceback" not in proc.stderr and not (tmp_path / "out").exists()

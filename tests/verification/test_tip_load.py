@@ -1,5 +1,6 @@
 """Tip-loaded cantilever with large deflection (paper Figs. 13-15), total-Lagrangian CTM-RPIM against
-the exact elastica; Newton history and cut-backs."""
+the exact elastica; Newton history and cut-backs, the increment series, the corner load (the quick tip-load
+study's case: solved through the study cache), displacement-driven loading."""
 from __future__ import annotations
 
 import pytest
@@ -9,6 +10,7 @@ from ctmrpim import benchmarks
 from ctmrpim.errors import ProblemError
 from ctmrpim.methods import solve
 from ctmrpim.reference import elastica
+from studies.sweep import CaseSpec
 
 L = 10.0
 TL = 'method.formulation="total-lagrangian"'
@@ -49,16 +51,6 @@ def test_newton_failure_is_a_clear_error() -> None:
                                            "loading.max_cutbacks=1"]))
 
 
-@pytest.mark.parametrize("overrides, message", [
-    (['material.model="linear-elastic"', 'method.formulation="total-lagrangian"'], "needs model = 'neo-hookean'"),
-    (['problem.analysis="linear"'], "needs model = 'linear-elastic'"),
-    (["loading.steps=0"], "loading.steps"),
-])
-def test_inconsistent_analysis_and_material_are_errors(overrides, message: str) -> None:
-    with pytest.raises(ProblemError, match=message):
-        benchmarks.load("tip-load", overrides)
-
-
 def test_increment_series_round_trip(solved, tmp_path) -> None:
     """result.pvd indexes one VTU per converged increment, on the current configuration."""
     import xml.etree.ElementTree as ET
@@ -79,10 +71,10 @@ def test_increment_series_round_trip(solved, tmp_path) -> None:
     assert "line" in last.cells_dict   # the boundary travels with the nodes
 
 
-def test_corner_load_against_the_eccentric_elastica() -> None:
+def test_corner_load_against_the_eccentric_elastica(study_cases) -> None:
     """The paper's set-up: P at the top-right corner acts like a tip moment P (W/2) sin(theta)."""
-    r = solve(benchmarks.load("tip-load-corner", ["parameters.lam=1.8", "loading.steps=8", TL]))
-    w = -r.probes["tip"]["uy"] / L
+    r, = study_cases(CaseSpec("tip-load-corner", ("parameters.lam=1.8", "loading.steps=8", TL)))
+    w = -r["probes"]["tip"]["uy"] / L
     check("tip-load-corner-tl-elastica", abs(w / elastica.tip_load_bvp(1.8, eccentricity=0.05).w_over_L - 1.0))
     assert w > elastica.tip_load_elliptic(1.8).w_over_L   # the corner load bends more than the end shear
 

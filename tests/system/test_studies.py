@@ -1,4 +1,5 @@
-"""Every study's quick mode, run through the sweep executor, checked against the tolerances table."""
+"""Every study's quick mode, run through the sweep executor (the run's study cache), checked against the
+tolerances table; one study alone in the fast tier."""
 from __future__ import annotations
 
 import pandas as pd
@@ -7,53 +8,40 @@ from verify import check
 
 import studies
 from studies import claims
-from studies.sweep import Sweep
 
 
-@pytest.fixture(scope="module")
-def sweep(tmp_path_factory) -> Sweep:
-    return Sweep(tmp_path_factory.mktemp("cache"), workers=2, progress=False)
+def test_a_study_writes_its_table_and_figure(quick_studies) -> None:
+    """One quick study (the column collapse: one explicit case, 0.1 s) through the sweep: a row per case, its
+    CSV and PNG."""
+    table = quick_studies["column_collapse"]
+    assert len(table) == 1 and (table.status == "ok").all()
+    assert len(pd.read_csv(quick_studies.reports / "column_collapse.csv")) == 1
+    assert (quick_studies.reports / "column_collapse.png").read_bytes()[:4] == b"\x89PNG"
 
 
-@pytest.fixture(scope="module")
-def tables(tmp_path_factory, sweep) -> dict[str, pd.DataFrame]:
-    root = tmp_path_factory.mktemp("studies")
-    return {name: studies.run(name, True, root / "reports", sweep, progress=lambda *_: None)
-            for name in studies.NAMES}
-
-
-def test_quick_report(tables, sweep, tmp_path) -> None:
-    """The main job: every section and figure is written and every check passes (the studies' cases
-    come from the shared cache, so this only adds the report's own work)."""
-    from studies.report import make_report
-
-    path = make_report(quick=True, out_dir=tmp_path, sweep=sweep, progress=lambda *_: None)
-    text = path.read_text()
-    assert "FAIL" not in text
-    for name in [*studies.NAMES, "deformed_shapes"]:
-        assert f"({name}.png)" in text and (tmp_path / f"{name}.png").is_file()
-    assert sweep.computed == 0
-
-
+@pytest.mark.slow
 def test_every_case_succeeds(tables) -> None:
     for name, df in tables.items():
         assert (df.status == "ok").all(), f"{name}: {df[df.status != 'ok'].to_dict('records')}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("key", sorted(claims.CLAIMS))
 def test_paper_claim(tables, key: str) -> None:
     values = claims.evaluate(tables)
     check(key, values[key])
 
 
-def test_outputs_written(tables, tmp_path_factory) -> None:
-    reports = next(p for p in tmp_path_factory.getbasetemp().rglob("reports") if p.is_dir())
+@pytest.mark.slow
+def test_outputs_written(tables, quick_studies) -> None:
+    reports = quick_studies.reports
     for name in studies.NAMES:
         assert (reports / f"{name}.csv").stat().st_size > 0
         assert (reports / f"{name}.png").read_bytes()[:4] == b"\x89PNG"
         assert len(pd.read_csv(reports / f"{name}.csv")) == len(tables[name])
 
 
+@pytest.mark.slow
 def test_tip_load_study_against_the_elastica(tables) -> None:
     tip = tables["tip_load"]
     ours = tip[tip.method == "ctm-rpim"]
@@ -63,10 +51,12 @@ def test_tip_load_study_against_the_elastica(tables) -> None:
     check("tip-load-corner-tl-elastica", corner.w_rel_diff.abs().max())
 
 
+@pytest.mark.slow
 def test_end_moment_study(tables) -> None:
     check("end-moment-tl-quarter", tables["end_moment"].tip_distance_over_L.iloc[0])
 
 
+@pytest.mark.slow
 def test_time_to_accuracy_targets(tables) -> None:
     from studies.time_to_accuracy import targets_table
 

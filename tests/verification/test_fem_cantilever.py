@@ -16,15 +16,15 @@ GRIDS = ((17, 5), (33, 9), (65, 17))
 L = 48.0
 
 
-
 @pytest.fixture(scope="module")
-def solved() -> dict[tuple[str, tuple[int, int]], Result]:
-    """Each (element, grid) solved once for the whole module (all together well under a second)."""
+def solved(solutions) -> dict[tuple[str, tuple[int, int]], Result]:
+    """Each (element, grid) solved once for the run (all together well under a second; shared with the
+    command-line tests and the README's example)."""
     out = {}
     for element in ("q1", "p2"):
         for grid in GRIDS:
             case = benchmarks.load("cantilever", overrides=[f"nodes.grid=[{grid[0]}, {grid[1]}]"])
-            out[element, grid] = solve_fem(case, element)
+            out[element, grid] = solutions(case, method="fem", element=element)
     return out
 
 

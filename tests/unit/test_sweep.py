@@ -1,10 +1,9 @@
-"""The sweep executor: caching by resolved input, resume, failures, local processes against Dask."""
+"""The sweep executor (studies.sweep): caching by resolved input, resume, failures, local processes against
+in-process (on a Dask cluster: system/test_dask.py)."""
 from __future__ import annotations
 
 import json
 from pathlib import Path
-
-import pytest
 
 from studies.sweep import CaseSpec, Sweep, case_hash
 
@@ -82,19 +81,3 @@ def test_processes_and_in_process_agree(tmp_path) -> None:
     serial = Sweep(tmp_path / "a", progress=False).run(SPECS)
     parallel = Sweep(tmp_path / "b", workers=2, progress=False).run(SPECS)
     assert numbers(serial) == numbers(parallel)
-
-
-def test_dask_local_cluster_gives_identical_results(tmp_path) -> None:
-    from dask import distributed  # a test dependency: never skipped
-    local = Sweep(tmp_path / "local", workers=2, progress=False).run(SPECS)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
-        remote = Sweep(tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False).run(SPECS)
-    assert numbers(local) == numbers(remote)
-
-
-def test_unreachable_scheduler_is_a_clear_error(tmp_path) -> None:
-    from ctmrpim.errors import ProblemError
-
-    with pytest.raises(ProblemError, match="Dask scheduler"):
-        Sweep(tmp_path, scheduler="tcp://127.0.0.1:9", progress=False).run(SPECS[:1])

@@ -1,0 +1,44 @@
+"""The compiled Mohr-Coulomb point update of the explicit step (ctmrpim.materials.mohr_coulomb_kernel)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ctmrpim.materials.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, MohrCoulomb, plastic_strain_increment
+from ctmrpim.materials.mohr_coulomb_kernel import point_update
+from ctmrpim.materials.objective_stress import hughes_winget_c, rotate_c
+
+
+@pytest.mark.parametrize("c, psi", [(0.0, 0.0), (2.0e3, 10.0)])
+def test_compiled_point_update_matches_the_numpy_forms(c, psi):
+    """The compiled per-point step is the numpy algebra (Hughes-Winget, rotation, Box 8.4 return, plastic
+    strain increment, dissipation) point for point, in every return region, to round-off."""
+    material = MohrCoulomb(E=0.84e6, nu=0.3, c=c, phi=19.8, psi=psi, density=2650.0)
+    rng = np.random.default_rng(5)
+    m = 4000
+    p = rng.uniform(-500.0, 4000.0, m)          # some tensile: the apex is reached where c = 0
+    stress = np.c_[-p * rng.uniform(0.3, 1.2, m), -p, p * rng.uniform(-0.4, 0.4, m), -p * rng.uniform(0.5, 1.0, m)]
+    stress, _ = material.update(stress, np.zeros((m, 3)))          # admissible starting states
+    plastic = 1e-3 * rng.standard_normal((m, 4))
+    f = np.tile([1.0, 0.0, 0.0, 1.0], (m, 1)) + 10.0 ** rng.uniform(-5, -2, (m, 1)) * rng.standard_normal((m, 4))
+    dead = rng.random(m) < 0.02
+    w = rng.uniform(0.5, 1.5, m)
+    got, got_plastic, region, dissipation, viscous, work = point_update(material, f, stress, plastic, dead, w,
+                                                                        np.ones((m, 4)), 2.0)
+    assert {ELASTIC, MAIN, RIGHT, LEFT} <= set(region[~dead]) and (c > 0 or APEX in set(region))
+    strain, cq, sq = hughes_winget_c(f)
+    rotated, rotated_plastic = rotate_c(stress, cq, sq), rotate_c(plastic, cq, sq)
+    want, want_region = material.update(rotated, strain)
+    dp = plastic_strain_increment(material, strain, want - rotated)
+    want[dead], dp[dead], rotated_plastic[dead] = 0.0, 0.0, 0.0
+    scale = np.abs(stress).max()
+    assert np.abs(got - want).max() < 1e-10 * scale
+    assert np.array_equal(region[~dead], want_region[~dead])
+    assert np.abs(got_plastic - (rotated_plastic + dp)).max() < 1e-13
+    density = 0.5 * ((rotated + want) * dp * [1.0, 1.0, 2.0, 1.0]).sum(axis=1)
+    assert dissipation == pytest.approx(w @ density, rel=1e-10, abs=1e-12 * scale)
+    D = material.D("strain")          # viscous stress beta D de / dt (beta / dt = 2 here), zz from plane strain
+    want_viscous = 2.0 * np.c_[strain @ D.T, D[0, 1] * (strain[:, 0] + strain[:, 1])][:, [0, 1, 2, 3]]
+    want_viscous[dead] = 0.0
+    assert np.abs(viscous - want_viscous).max() < 1e-12 * np.abs(want_viscous).max()
+    assert work == pytest.approx(w[~dead] @ strain[~dead].sum(axis=1), rel=1e-12)   # unit old viscous stress

@@ -1,0 +1,49 @@
+"""Node placement (ctmrpim.problem.node_cloud): tensor grids, spacing on curved boundaries, no clumps."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+from ctmrpim import benchmarks
+from ctmrpim.problem.geometry import Geometry, Shape
+from ctmrpim.problem.node_cloud import NodeSpec, check_nodes_inside, make_nodes
+
+
+def test_grid_on_a_rectangle_is_the_tensor_grid() -> None:
+    case = benchmarks.load("cantilever", ["nodes.grid=[17,5]"])
+    nodes = make_nodes(case.problem.geometry, case.nodes)
+    assert nodes.shape == (85, 2)
+    assert np.unique(nodes[:, 0]).tolist() == np.linspace(0, 48, 17).tolist()
+    assert np.unique(nodes[:, 1]).tolist() == np.linspace(-6, 6, 5).tolist()
+
+
+@pytest.mark.parametrize("h", [0.5, 0.25])
+def test_spacing_on_a_plate_with_a_hole(h: float) -> None:
+    r = 1.0
+    g = Geometry(add=[Shape("rectangle", (-4.0, -4.0, 4.0, 4.0))], subtract=[Shape("circle", (0.0, 0.0, r))])
+    nodes = make_nodes(g, NodeSpec(spacing=h))
+    assert np.all(g.distance_outside(nodes) == 0.0)          # inside the body or on its boundary
+    check_nodes_inside(g, nodes, tol=1e-12)                  # and no two coincide
+    d = np.hypot(nodes[:, 0], nodes[:, 1])
+    on_hole = d < r + 0.1 * h
+    assert abs(on_hole.sum() - 2 * math.pi * r / h) <= 1
+    assert np.abs(d[on_hole] - r).max() < 1e-12 * r          # exactly on the true arc, not on a chord
+    # the interior grid keeps clear of the boundary nodes: no clumps
+    gap, _ = cKDTree(nodes).query(nodes, k=2)
+    assert gap[:, 1].min() > 0.4 * h
+    assert len(nodes) > g.area / h**2
+
+
+def test_boundary_nodes_on_a_large_arc_lie_on_it() -> None:
+    """A spacing far below the radius: the sagitta (1e-5 r), not the spacing, bounds how far off the
+    arc the polygon's points are, and the snapping must reach that far (it once used 1e-3 h)."""
+    r, h = 1.0, 0.002
+    g = Geometry(add=[Shape("rectangle", (0.0, 0.0, 0.1, 0.1))], subtract=[Shape("circle", (1.05, 0.05, r))])
+    nodes = make_nodes(g, NodeSpec(spacing=h))
+    d = np.hypot(nodes[:, 0] - 1.05, nodes[:, 1] - 0.05)
+    on_arc = d < r + 0.1 * h
+    assert on_arc.sum() > 40
+    assert np.abs(d[on_arc] - r).max() < 1e-12 * r
