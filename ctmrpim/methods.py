@@ -20,7 +20,7 @@ from ctmrpim.problem.case import Case
 from ctmrpim.result import Result
 from ctmrpim.run_options import RunOptions
 
-#: entry-point group of methods that live in other packages
+#: entry-point group that announces the methods (this package's and the references')
 GROUP = "ctmrpim.methods"
 #: the method this package implements
 DEFAULT = "ctm-rpim"
