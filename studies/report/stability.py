@@ -66,7 +66,7 @@ def write_slope_stability(w: Writer, sl: pd.DataFrame) -> None:
       "depth (with nu = 0.3 the elastic K0 = 0.43 state lies on the Mohr-Coulomb edge sigma_xx = sigma_zz "
       "below about 11.6 m of cover); there full Newton wanders for tens of iterations, so the slopes iterate "
       "on the elastic stiffness (factorised once for the whole search) with Anderson-mixed steps "
-      "(`loading.tangent = \"elastic\"`, see `ctmrpim/elastoplastic.py`).\n\n")
+      "(`loading.tangent = \"elastic\"`, see `ctmrpim/solvers/plastic_system.py`).\n\n")
 
 
 def write_srf_sweep(w: Writer, sw: pd.DataFrame) -> None:

@@ -16,7 +16,7 @@ def write_title(w: Writer, quick: bool, checks: pd.DataFrame, claim_rows: pd.Dat
       f"{'Quick mode: fewer parameter values and coarser grids than the paper; `--full` runs the paper resolution.' if quick else 'Full mode: the paper resolution.'}\n\n")
     n_fail = int((checks["pass"] == "FAIL").sum() + (claim_rows["pass"] == "FAIL").sum())
     w(f"**{len(checks) + len(claim_rows) - n_fail} of {len(checks) + len(claim_rows)} checks pass.** "
-      "Limits come from `ctmrpim/tolerances.toml`, the same table the tests read.\n\n")
+      "Limits come from `studies/tolerances.toml`, the same table the tests read.\n\n")
 
 
 def write_claims(w: Writer, claim_rows: pd.DataFrame) -> None:
