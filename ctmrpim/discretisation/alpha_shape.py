@@ -11,6 +11,7 @@ validated before anyone integrates over it.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 from scipy.spatial import Delaunay, QhullError
@@ -74,12 +75,18 @@ def circumradii(points: np.ndarray, tri: np.ndarray) -> np.ndarray:
 
 
 def alpha_shape(points: np.ndarray, alpha: float, d_c: float, reference: np.ndarray | None = None,
-                max_reference_edge: float | None = None) -> Boundary:
-    """Tracked boundary of ``points`` for an absolute alpha radius (paper Section 2.4).
+                max_reference_edge: float | None = None,
+                inside: Callable[[np.ndarray], np.ndarray] | None = None) -> Boundary:
+    """Tracked boundary of ``points`` (n, 2) for an absolute alpha radius (paper Section 2.4).
 
     On a deformed cloud, ``reference`` (the nodes' reference positions) and ``max_reference_edge``
     also drop every triangle with an edge longer than that in the reference configuration: nodes
     that were far apart (the two ends of a beam rolled into a ring) are never joined into the body.
+    Where the body's geometry is known (the reference configuration), ``inside`` ((k, 2) points ->
+    (k,) bool) drops every triangle whose centroid lies outside it: the alpha shape alone spans the
+    notch of a re-entrant corner with a triangle as small as any inside (a square grid's corner node
+    and its two neighbours), and cuts the corner off; a hole one or two spacings across is kept, not
+    filled as a gap.
     """
     points = np.asarray(points, dtype=float)
     if len(points) < 3:
@@ -93,6 +100,8 @@ def alpha_shape(points: np.ndarray, alpha: float, d_c: float, reference: np.ndar
     cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
     tri[cw] = tri[cw][:, [0, 2, 1]]
     keep = circumradii(points, tri) < alpha
+    body = np.ones(len(tri), bool) if inside is None else np.asarray(inside(points[tri].mean(axis=1)), bool)
+    keep &= body
     if reference is not None and max_reference_edge is not None:
         r = np.asarray(reference, float)[tri]
         longest = np.max(np.linalg.norm(r - np.roll(r, 1, axis=1), axis=2), axis=1)
@@ -106,8 +115,7 @@ def alpha_shape(points: np.ndarray, alpha: float, d_c: float, reference: np.ndar
     if small:
         centroids = points[tri].mean(axis=1)
         for lp in small:
-            inside = ~keep & _inside(centroids, points[lp])
-            keep |= inside
+            keep |= ~keep & body & _inside(centroids, points[lp])
         filled = len(small)
         loops = _loops(points, tri[keep])
 

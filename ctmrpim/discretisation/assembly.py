@@ -56,6 +56,32 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     return sp.bsr_matrix((blocks, pattern.indices, pattern.indptr), shape=(2 * n, 2 * n)).tocsr()
 
 
+def petrov_galerkin_stiffness(test_dx: sp.csr_matrix, test_dy: sp.csr_matrix, dNdx: sp.csr_matrix,
+                              dNdy: sp.csr_matrix, weights: np.ndarray, D: np.ndarray) -> sp.csr_matrix:
+    """K (2n x 2n) = sum_p B~_p^T D B_p w_p with the test gradients ``test_dx``, ``test_dy`` and the trial
+    gradients ``dNdx``, ``dNdy`` (all (m, n) on one sparsity pattern) at m points with ``weights`` (m,);
+    not symmetric (:mod:`ctmrpim.discretisation.consistent_integration`). D as in :func:`stiffness`."""
+    if abs(D[0, 2]) > 0 or abs(D[1, 2]) > 0:
+        raise NotImplementedError("petrov_galerkin_stiffness() assumes D[0, 2] = D[1, 2] = 0")
+    n = dNdx.shape[1]
+    rows = np.repeat(np.arange(dNdx.shape[0]), np.diff(dNdx.indptr))
+    scaled = [sp.csr_matrix((M.data * weights[rows], M.indices, M.indptr), shape=M.shape) for M in (dNdx, dNdy)]
+    tx, ty = test_dx.T.tocsr(), test_dy.T.tocsr()
+    products = [tx @ scaled[0], tx @ scaled[1], ty @ scaled[0], ty @ scaled[1]]    # xx, xy, yx, yy
+    pattern = abs(products[0])
+    for p in products[1:]:
+        pattern = pattern + abs(p)
+    pattern = pattern.tocsr()
+    pattern.sort_indices()
+    xx, xy, yx, yy = (_on_pattern(p.tocsr(), pattern) for p in products)
+    blocks = np.empty((len(xx), 2, 2))
+    blocks[:, 0, 0] = D[0, 0] * xx + D[2, 2] * yy
+    blocks[:, 0, 1] = D[0, 1] * xy + D[2, 2] * yx
+    blocks[:, 1, 0] = D[1, 0] * yx + D[2, 2] * xy
+    blocks[:, 1, 1] = D[1, 1] * yy + D[2, 2] * xx
+    return sp.bsr_matrix((blocks, pattern.indices, pattern.indptr), shape=(2 * n, 2 * n)).tocsr()
+
+
 def _on_pattern(a: sp.csr_matrix, pattern: sp.csr_matrix) -> np.ndarray:
     """The entries of ``a`` laid out on ``pattern``'s (sorted, larger) sparsity, zeros elsewhere."""
     n = a.shape[1]

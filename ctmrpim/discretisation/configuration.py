@@ -177,9 +177,10 @@ class ReferenceCloud:
 
 
 def track_boundary(case: Case, nodes: np.ndarray, lengths: ScaledMethod) -> Boundary:
-    """The body's boundary from the node cloud (alpha shape), checked against the geometry's area."""
+    """The body's boundary from the node cloud (alpha shape restricted to the geometry, so corners are
+    kept), checked against the geometry's area."""
     geometry = case.problem.geometry
-    boundary = alpha_shape(nodes, lengths.alpha, lengths.d_c)
+    boundary = alpha_shape(nodes, lengths.alpha, lengths.d_c, inside=geometry.contains)
     if len(boundary.detached):
         i = boundary.detached[0]
         raise ProblemError(f"{len(boundary.detached)} node(s) are outside the alpha shape, e.g. #{i} at "

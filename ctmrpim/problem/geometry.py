@@ -123,6 +123,11 @@ class Geometry:
         """Distance of each point from the body (0 inside or on the boundary)."""
         return shapely.distance(self.region, shapely.points(points))
 
+    def contains(self, points: np.ndarray) -> np.ndarray:
+        """(k,) bool: which of the points (k, 2) lie strictly inside the body."""
+        points = np.asarray(points, float).reshape(-1, 2)
+        return shapely.contains_xy(self.region, points[:, 0], points[:, 1])
+
     def distance_to_boundary(self, points: np.ndarray) -> np.ndarray:
         """(k,) distance of each of the points (k, 2) from the body's boundary, inside or outside."""
         return shapely.distance(self.region.boundary, shapely.points(points))

@@ -22,6 +22,10 @@ BOUNDARIES = ("alpha", "geometry")
 LINEAR_SOLVERS = ("auto", "banded", "superlu", "spsolve")
 #: large-deformation (quasi-static) formulations: the paper's adaptive one, and the cross-check
 FORMULATIONS = ("updated-lagrangian", "total-lagrangian")
+#: integration schemes: the paper's CTM, and CTM with variationally consistent test gradients (VCI)
+INTEGRATIONS = ("ctm", "ctm-vci")
+#: the order of the VCI correction: the integration constraints it makes hold
+CORRECTIONS = ("linear", "quadratic")
 #: how a strength-reduction level is equilibrated
 REDUCTION_SOLVERS = ("newton", "dynamic-relaxation")
 
@@ -81,6 +85,9 @@ class Method:
                                          # this since they were laid; 0 = every increment (the paper)
     min_support: int = 0                 # explicit dynamics: widen a support holding fewer nodes than this to
                                          # its min_support nearest (a thinning flow front); 0 = r_c alone
+    integration: str = "ctm"             # "ctm": the paper's; "ctm-vci": test gradients corrected so that the
+                                         # integration constraints hold (linear analyses)
+    correction: str = "quadratic"        # ctm-vci: linear or quadratic integration constraints
 
     def __post_init__(self) -> None:
         self.line_spacing = tuple(float(v) for v in self.line_spacing)
@@ -100,6 +107,8 @@ class Method:
             ("formulation", self.formulation in FORMULATIONS, f"must be one of {list(FORMULATIONS)}"),
             ("point_regeneration", self.point_regeneration >= 0, "must be >= 0 (0: every increment)"),
             ("min_support", integer(self.min_support, 0), "must be an integer >= 0 (0: off)"),
+            ("integration", self.integration in INTEGRATIONS, f"must be one of {list(INTEGRATIONS)}"),
+            ("correction", self.correction in CORRECTIONS, f"must be one of {list(CORRECTIONS)}"),
         ])
         nearest = round(self.eta)
         if nearest % 2 == 0 and abs(self.eta - nearest) < 1e-9:

@@ -7,10 +7,12 @@ field nodes --alpha shape--> boundary loops --CTM--> integration points and weig
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
-from ctmrpim.discretisation import assembly
-from ctmrpim.discretisation.configuration import boundary_tags, reference_configuration
+from ctmrpim.discretisation import assembly, consistent_integration
+from ctmrpim.discretisation.configuration import BoundaryTags, Configuration, boundary_tags, reference_configuration
 from ctmrpim.discretisation.ctm import integration_points
+from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
 from ctmrpim.reference.error_norms import relative_errors
 from ctmrpim.result import Result, probe_errors, probe_record
@@ -23,6 +25,23 @@ from ctmrpim.timing import Timer
 ERROR_CELL = 2.0
 ERROR_GAUSS = 3
 ERROR_MIN_BAND = 0.25   # merge vertex ordinates closer than this (x d_c): circles have hundreds of vertices
+
+
+def consistent_stiffness(case: Case, conf: Configuration, tags: BoundaryTags, D: np.ndarray) -> sp.csr_matrix:
+    """K (2n x 2n) of ``method.integration = "ctm-vci"``: Petrov-Galerkin with the corrected test gradients,
+    minus the Dirichlet consistency term (:mod:`ctmrpim.discretisation.consistent_integration`)."""
+    if case.method.boundary != "alpha":
+        raise ProblemError("method.integration = \"ctm-vci\" integrates over the node loops of the tracked "
+                           "boundary; set method.boundary = \"alpha\"", key="method.integration")
+    boundary = consistent_integration.boundary_quadrature(conf.x, conf.boundary.edges)
+    sf_b = conf.shape_functions_at(boundary.points)
+    thickness = case.problem.thickness
+    test_dx, test_dy = consistent_integration.corrected_gradients(
+        conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf, boundary, sf_b.N, case.method.correction)
+    K = assembly.petrov_galerkin_stiffness(test_dx, test_dy, conf.sf.dNdx, conf.sf.dNdy, conf.w, D)
+    return K - consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, boundary, sf_b, D, thickness)
+
+
 def solve_ctmrpim(case: Case) -> Result:
     """Solve a linear-elastic Case with CTM-RPIM."""
     problem, method = case.problem, case.method
@@ -35,13 +54,16 @@ def solve_ctmrpim(case: Case) -> Result:
     fixed, fixed_values, traction_q = tags.fixed, tags.fixed_values, tags.traction
 
     D = problem.D()
-    K = assembly.stiffness(sf.dNdx, sf.dNdy, conf.w, D)
+    consistent = method.integration == "ctm-vci"
+    K = consistent_stiffness(case, conf, tags, D) if consistent else assembly.stiffness(sf.dNdx, sf.dNdy, conf.w, D)
     F = assembly.load_vector(N_traction, traction_q.weights * problem.thickness, tags.tx, tags.ty)
     F += problem.thickness * conf.point_forces(problem)
     F += assembly.body_force_vector(sf.N, conf.w, problem)
     timer.lap("assembly")
 
-    U = solve_constrained(K, F, fixed, fixed_values, method.solver)
+    # K of the consistent scheme is not symmetric: no Cholesky
+    U = solve_constrained(K, F, fixed, fixed_values, "superlu" if consistent and method.solver in ("auto", "banded")
+                          else method.solver)
     u = U.reshape(-1, 2)
     timer.lap("solve")
 

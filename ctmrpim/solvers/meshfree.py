@@ -12,6 +12,7 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.methods import SolutionMethod
 from ctmrpim.problem.case import Case
@@ -22,6 +23,9 @@ from ctmrpim.run_options import RunOptions
 def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Result:
     """Solve ``case`` with CTM-RPIM (``element`` is always None: the method has none)."""
     analysis = case.problem.analysis
+    if case.method.integration != "ctm" and analysis != "linear":
+        raise ProblemError(f"method.integration = {case.method.integration!r} is implemented for linear analyses; "
+                           f"a {analysis!r} analysis integrates with \"ctm\"", key="method.integration")
     if analysis == "explicit":
         from ctmrpim.solvers.explicit.run import solve_explicit
         if options.out is None:

@@ -79,3 +79,23 @@ def test_bad_mohr_coulomb_input_names_the_key(tmp_path, change, message: str) ->
     path.write_text(change(BLOCK.read_text()))
     with pytest.raises(ProblemError, match=message):
         load_case(str(path), [])
+
+
+@pytest.mark.parametrize("target, change", [
+    ("cantilever", ['method.integration="vci"']),
+    ("cantilever", ['method.correction="cubic"']),
+])
+def test_bad_integration_settings_name_the_key(target: str, change: list[str]) -> None:
+    with pytest.raises(ProblemError, match=r"method\.(integration|correction)"):
+        benchmarks.load(target, change)
+
+
+@pytest.mark.parametrize("target, change", [
+    ("tip-load", ['method.integration="ctm-vci"']),                                 # not a linear analysis
+    ("cantilever", ['method.integration="ctm-vci"', 'method.boundary="geometry"']),  # not on the node loops
+])
+def test_consistent_integration_is_refused_where_it_is_not_implemented(target: str, change: list[str]) -> None:
+    import ctmrpim
+
+    with pytest.raises(ProblemError, match=r"method\.integration"):
+        ctmrpim.solve(benchmarks.load(target, change))
