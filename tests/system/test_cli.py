@@ -105,7 +105,8 @@ def test_summary_holds_the_resolved_input(run) -> None:
     # the defaults that were applied are listed
     assert s["defaults_applied"] == ["problem.gravity = [0.0, 0.0]", "method.boundary = 'alpha'", "method.solver = 'auto'",
                                      "method.match_tolerance = 0.01", "method.formulation = 'updated-lagrangian'",
-                                     "method.point_regeneration = 0.0", "method.min_support = 0"]
+                                     "method.point_regeneration = 0.0", "method.min_support = 0",
+                                     "method.integration = 'ctm'", "method.correction = 'quadratic'"]
 
 
 def test_summary_counts_timings_probes_errors(run, api) -> None:
