@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from studies.sweep import CaseSpec, element_of
+from studies.sweep import CaseSpec, element_for
 
 from .base import finished, new_figure
 
@@ -34,7 +34,7 @@ def specs(quick: bool) -> list[CaseSpec]:
     """CTM-RPIM and scikit-fem P2 on each node grid."""
     grids = GRIDS["quick" if quick else "full"]
     return [CaseSpec("footing", (f"parameters.nx={nx}", f"parameters.ny={ny}"), solver,
-                     element_of(solver, "p2"), labels=(("grid", f"{nx} x {ny}"),))
+                     element_for(solver, "p2"), labels=(("grid", f"{nx} x {ny}"),))
             for nx, ny in grids for solver in ("ctm-rpim", "fem")]
 
 

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import pandas as pd
 
-from studies.sweep import CaseSpec, element_of
+from studies.sweep import CaseSpec, element_for
 
 from .base import finished, new_figure
 
@@ -32,7 +32,7 @@ def specs(quick: bool) -> list[CaseSpec]:
     """CTM-RPIM and scikit-fem P2 on the slope, each SRF on its own, by dynamic relaxation."""
     p = QUICK if quick else FULL
     return [CaseSpec("slope", (f"parameters.h={p['h']!r}", f"strength-reduction.values=[{s!r}]", *SOLVER), solver,
-                     element_of(solver, "p2"), labels=(("srf", s),)) for s in p["srf"] for solver in ("ctm-rpim", "fem")]
+                     element_for(solver, "p2"), labels=(("srf", s),)) for s in p["srf"] for solver in ("ctm-rpim", "fem")]
 
 
 def extra(summary: dict) -> dict:

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import pandas as pd
 
-from studies.sweep import CaseSpec, element_of
+from studies.sweep import CaseSpec, element_for
 
 from .base import finished, new_figure
 
@@ -27,7 +27,7 @@ FULL = {"h": 0.58, "srf": [0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.35, 1.4, 1.5, 1.6]}
 def specs(quick: bool) -> list[CaseSpec]:
     """CTM-RPIM and scikit-fem P2 on the slope, each SRF on its own (gravity ramped at the reduced strength)."""
     p = QUICK if quick else FULL
-    return [CaseSpec("slope", (f"parameters.h={p['h']!r}", f"strength-reduction.values=[{s!r}]"), solver, element_of(solver, "p2"),
+    return [CaseSpec("slope", (f"parameters.h={p['h']!r}", f"strength-reduction.values=[{s!r}]"), solver, element_for(solver, "p2"),
                      labels=(("srf", s),)) for s in p["srf"] for solver in ("ctm-rpim", "fem")]
 
 

@@ -19,7 +19,7 @@ import pandas as pd
 
 from ctmrpim import benchmarks
 from ctmrpim.reference.limit_equilibrium import problem_factor_of_safety
-from studies.sweep import CaseSpec, element_of
+from studies.sweep import CaseSpec, element_for
 
 from .base import finished, new_figure
 
@@ -41,7 +41,7 @@ def bishop(target: str) -> float:
 def specs(quick: bool) -> list[CaseSpec]:
     """CTM-RPIM and scikit-fem P2 on each slope geometry at each node spacing."""
     mode = "quick" if quick else "full"
-    return [CaseSpec(target, (f"parameters.h={h!r}",), solver, element_of(solver, "p2"), labels=(("slope", target), ("h", h)))
+    return [CaseSpec(target, (f"parameters.h={h!r}",), solver, element_for(solver, "p2"), labels=(("slope", target), ("h", h)))
             for target, hs in SPACING.items() for h in hs[mode] for solver in ("ctm-rpim", "fem")]
 
 

@@ -48,9 +48,12 @@ class CaseSpec:
         return dict(self.labels)
 
 
-def element_of(solver: str, element: str) -> str | None:
-    """``element`` for a finite-element method, None for CTM-RPIM (which has no elements)."""
-    return None if solver == "ctm-rpim" else element
+def element_for(solver: str, element: str) -> str | None:
+    """``element`` for a method that has elements (a finite-element reference), None for one that has none
+    (CTM-RPIM), so that one study can list both methods with one element."""
+    from ctmrpim.methods import get
+
+    return element if get(solver).elements else None
 
 
 @cache

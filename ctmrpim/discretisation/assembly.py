@@ -26,8 +26,7 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     """K (2n x 2n) = sum_p B_p^T D B_p w_p (Eq. 5) from the derivatives ``dNdx``, ``dNdy`` (m, n) at m points
     with ``weights`` (m,), for one constant D (3, 3) with D[0, 2] = D[1, 2] = 0 (isotropic or orthotropic in
     its axes); rows and columns of dNdx and dNdy must share one sparsity pattern."""
-    if abs(D[0, 2]) > 0 or abs(D[1, 2]) > 0:
-        raise NotImplementedError("stiffness() assumes D[0, 2] = D[1, 2] = 0 (isotropic or orthotropic)")
+    _check_axes(D)
     n = dNdx.shape[1]
     z = dNdx.data + 1j * dNdy.data
     rows = np.repeat(np.arange(dNdx.shape[0]), np.diff(dNdx.indptr))
@@ -48,12 +47,7 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     yy = 0.5 * (d2.real - d1.real)
     xy = 0.5 * (d1.imag + d2.imag)
     yx = 0.5 * (d1.imag - d2.imag)
-    blocks = np.empty((len(xx), 2, 2))
-    blocks[:, 0, 0] = D[0, 0] * xx + D[2, 2] * yy
-    blocks[:, 0, 1] = D[0, 1] * xy + D[2, 2] * yx
-    blocks[:, 1, 0] = D[0, 1] * yx + D[2, 2] * xy
-    blocks[:, 1, 1] = D[1, 1] * yy + D[2, 2] * xx
-    return sp.bsr_matrix((blocks, pattern.indices, pattern.indptr), shape=(2 * n, 2 * n)).tocsr()
+    return _block_stiffness(pattern, xx, xy, yx, yy, D, n)
 
 
 def petrov_galerkin_stiffness(test_dx: sp.csr_matrix, test_dy: sp.csr_matrix, dNdx: sp.csr_matrix,
@@ -61,8 +55,7 @@ def petrov_galerkin_stiffness(test_dx: sp.csr_matrix, test_dy: sp.csr_matrix, dN
     """K (2n x 2n) = sum_p B~_p^T D B_p w_p with the test gradients ``test_dx``, ``test_dy`` and the trial
     gradients ``dNdx``, ``dNdy`` (all (m, n) on one sparsity pattern) at m points with ``weights`` (m,);
     not symmetric (:mod:`ctmrpim.discretisation.consistent_integration`). D as in :func:`stiffness`."""
-    if abs(D[0, 2]) > 0 or abs(D[1, 2]) > 0:
-        raise NotImplementedError("petrov_galerkin_stiffness() assumes D[0, 2] = D[1, 2] = 0")
+    _check_axes(D)
     n = dNdx.shape[1]
     rows = np.repeat(np.arange(dNdx.shape[0]), np.diff(dNdx.indptr))
     scaled = [sp.csr_matrix((M.data * weights[rows], M.indices, M.indptr), shape=M.shape) for M in (dNdx, dNdy)]
@@ -74,10 +67,22 @@ def petrov_galerkin_stiffness(test_dx: sp.csr_matrix, test_dy: sp.csr_matrix, dN
     pattern = pattern.tocsr()
     pattern.sort_indices()
     xx, xy, yx, yy = (_on_pattern(p.tocsr(), pattern) for p in products)
+    return _block_stiffness(pattern, xx, xy, yx, yy, D, n)
+
+
+def _check_axes(D: np.ndarray) -> None:
+    if abs(D[0, 2]) > 0 or abs(D[1, 2]) > 0:
+        raise NotImplementedError("the stiffness assembly assumes D[0, 2] = D[1, 2] = 0 (isotropic or orthotropic)")
+
+
+def _block_stiffness(pattern: sp.csr_matrix, xx: np.ndarray, xy: np.ndarray, yx: np.ndarray, yy: np.ndarray,
+                     D: np.ndarray, n: int) -> sp.csr_matrix:
+    """K (2n x 2n) from the node-pair sums xx_IJ = sum_p w_p dN_I/dx dN_J/dx (and xy, yx, yy) on ``pattern``:
+    the 2 x 2 block of each pair is B_I^T D B_J written out for D[0, 2] = D[1, 2] = 0 (D symmetric)."""
     blocks = np.empty((len(xx), 2, 2))
     blocks[:, 0, 0] = D[0, 0] * xx + D[2, 2] * yy
     blocks[:, 0, 1] = D[0, 1] * xy + D[2, 2] * yx
-    blocks[:, 1, 0] = D[1, 0] * yx + D[2, 2] * xy
+    blocks[:, 1, 0] = D[0, 1] * yx + D[2, 2] * xy
     blocks[:, 1, 1] = D[1, 1] * yy + D[2, 2] * xx
     return sp.bsr_matrix((blocks, pattern.indices, pattern.indptr), shape=(2 * n, 2 * n)).tocsr()
 
