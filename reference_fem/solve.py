@@ -56,6 +56,10 @@ def solve_fem(case: Case, element: str = "q1") -> Result:
     bx, by = problem.body_force
     if bx or by:                                       # gravity: int (density g) . v dx
         F += problem.thickness * LinearForm(lambda v, w: bx * v[0] + by * v[1]).assemble(basis)
+    if problem.body_load is not None:                  # [body-force]: int b(x) . v dx
+        load = problem.body_load
+        F += problem.thickness * LinearForm(
+            lambda v, w: load.bx(w.x[0], w.x[1]) * v[0] + load.by(w.x[0], w.x[1]) * v[1]).assemble(basis)
     fixed, values = constrained_dofs(problem, fm, basis, tol)
     timer.lap("assembly")
 

@@ -25,19 +25,26 @@ if TYPE_CHECKING:
 CACHE = Path("runs") / "sweeps"   # one folder per case, named by the hash of its resolved input
 
 
-def method_name(spec: CaseSpec) -> str:
-    """The method column of a case's row: ``fem-ELEMENT``, ``ctm-rpim`` or ``ctm-rpim-quadratic``."""
+def method_name(spec: CaseSpec, summary: dict | None = None) -> str:
+    """The method column of a case's row: ``fem-ELEMENT``, or ``ctm-rpim``, ``ctm-rpim-quadratic`` with
+    ``-vci`` appended for the consistent integration (read from the ``summary`` where the case ran, else
+    from the overrides)."""
     if spec.solver == "fem":
         return f"fem-{spec.element}"
-    quadratic = any(o.replace(" ", "") == 'method.polynomial="quadratic"' for o in spec.overrides)
-    return "ctm-rpim-quadratic" if quadratic else "ctm-rpim"
+    given = [o.replace(" ", "") for o in spec.overrides]
+    name = "ctm-rpim-quadratic" if 'method.polynomial="quadratic"' in given else "ctm-rpim"
+    if summary is not None:
+        consistent = summary["parameters"].get("method", {}).get("integration") == "ctm-vci"
+    else:
+        consistent = 'method.integration="ctm-vci"' in given
+    return name + "-vci" if consistent else name
 
 
 def metrics(outcome: CaseOutcome, extra: Callable[..., dict[str, Any]] | None = None) -> dict[str, Any]:
     """The numbers a study tabulates from one case's summary.json (plus ``extra(summary)``)."""
-    row: dict[str, Any] = {**outcome.spec.label_dict(), "method": method_name(outcome.spec),
-                           "status": outcome.status}
     s = outcome.summary
+    row: dict[str, Any] = {**outcome.spec.label_dict(), "method": method_name(outcome.spec, s),
+                           "status": outcome.status}
     if s is None:
         return {**row, "error_message": outcome.error}
     errors = s.get("errors", {})

@@ -1,6 +1,7 @@
 """Two-parameter map (not in the paper): the cantilever tip error over support radius r_c/d_c and
-shape parameter eta together, 17 x 5 nodes, r = d_c/3, one Gauss point, as a heat map. It shows
-whether the paper's one-at-a-time recommendations (r_c = 3.5-4 d_c, eta = 4.5-7.5) hold jointly.
+shape parameter eta together, 17 x 5 nodes, r = d_c/3, one Gauss point, the paper's integration, as a
+heat map. It shows whether the paper's one-at-a-time recommendations (r_c = 3.5-4 d_c, eta = 4.5-7.5) hold
+jointly.
 """
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
+from studies.schemes import PAPER, scheme_override
 from studies.sweep import CaseSpec
 
 from .base import new_figure
@@ -26,7 +28,8 @@ FULL = ([2.0 + 0.5 * i for i in range(9)], [2.5 + 1.0 * i for i in range(8)])
 def specs(quick: bool) -> list[CaseSpec]:
     """The cantilever (17 x 5) at each pair of r_c/d_c and eta."""
     radii, etas = QUICK if quick else FULL
-    return [CaseSpec("cantilever", ("nodes.grid=[17, 5]", f"method.support_radius={rc!r}", f"method.eta={eta!r}"),
+    return [CaseSpec("cantilever", ("nodes.grid=[17, 5]", f"method.support_radius={rc!r}", f"method.eta={eta!r}",
+                                    scheme_override(PAPER)),
                      labels=(("rc_over_dc", rc), ("eta", eta)))
             for rc in radii for eta in etas]
 

@@ -196,6 +196,11 @@ def reference_cloud(case: Case, timer: Timer) -> ReferenceCloud:
     lengths = case.method.scaled(mean_node_spacing(geometry.area, len(nodes)))
     check_nodes_inside(geometry, nodes, tol=lengths.match_tolerance)
     boundary = track_boundary(case, nodes, lengths)
+    expected = len(geometry.loops())
+    if len(boundary.loops) < expected:
+        raise ProblemError(f"the geometry has {expected} boundary loops, the node cloud resolves "
+                           f"{len(boundary.loops)}: a hole about the node spacing ({lengths.d_c:.3g}) across or "
+                           "smaller is lost; refine the nodes or remove the hole", key="nodes")
     timer.lap("boundary")
     return ReferenceCloud(nodes, lengths, boundary)
 

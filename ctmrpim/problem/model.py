@@ -92,11 +92,25 @@ class ExactSolution:
         return np.c_[self.sxx(x, y), self.syy(x, y), self.sxy(x, y)]
 
 
+@dataclass(frozen=True)
+class BodyForce:
+    """A body force per unit volume that varies over the body (``[body-force]``: a manufactured solution's, for
+    example), added to density * gravity (Eq. 6, body term)."""
+
+    bx: Field
+    by: Field
+
+    def at(self, points: np.ndarray) -> np.ndarray:
+        """(k, 2) bx, by at the points (k, 2)."""
+        return np.c_[self.bx(points[:, 0], points[:, 1]), self.by(points[:, 0], points[:, 1])]
+
+
 @dataclass
 class Problem:
     """The continuous problem (module docstring): geometry, material (any of :mod:`ctmrpim.materials`), analysis
     (``linear``, ``quasi-static``, ``strength-reduction``, ``dynamic``, ``explicit``), plane ``stress`` or
-    ``strain``, thickness, gravity, the expressions' parameters, constraints, loads, probes, walls, exact solution."""
+    ``strain``, thickness, gravity, the expressions' parameters, constraints, loads, probes, walls, exact solution,
+    a body force that varies in space."""
     name: str
     geometry: Geometry
     material: LinearElastic
@@ -112,6 +126,7 @@ class Problem:
     point_loads: list[PointLoad] = field(default_factory=list)
     walls: list[Wall] = field(default_factory=list)     # rigid walls of explicit dynamics
     exact: ExactSolution | None = None
+    body_load: BodyForce | None = None                  # [body-force], besides density * gravity
 
     def D(self) -> np.ndarray:
         """(3, 3) the material's (small-strain) elasticity matrix in the problem's plane state."""

@@ -66,6 +66,9 @@ def _fill(geometry: Geometry, hx: float, hy: float) -> np.ndarray:
     x0, y0, x1, y1 = geometry.bounds
     boundary = np.concatenate([_resample_loop(loop, h) for loop in geometry.loops()])
     boundary = geometry.snap_to_circles(boundary, tol=1e-3 * h)
+    # a circle tangent to another shape leaves two polygon vertices a hair apart, which snapping makes one
+    _, first = np.unique(np.round(boundary / (1e-6 * h)), axis=0, return_index=True)
+    boundary = boundary[np.sort(first)]
     X, Y = np.meshgrid(np.arange(x0, x1 + 0.5 * hx, hx), np.arange(y0, y1 + 0.5 * hy, hy))
     grid = np.c_[X.ravel(), Y.ravel()]
     inside = shapely.contains_xy(geometry.region, grid[:, 0], grid[:, 1])
@@ -81,13 +84,22 @@ def _fill(geometry: Geometry, hx: float, hy: float) -> np.ndarray:
     return nodes
 
 
+def _turning_angles(loop: np.ndarray) -> np.ndarray:
+    """|turning angle| at each vertex of a closed loop (k, 2), radians."""
+    a, b = loop - np.roll(loop, 1, axis=0), np.roll(loop, -1, axis=0) - loop
+    return np.abs(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1)))
+
+
+def geometry_corners(geometry: Geometry) -> np.ndarray:
+    """(c, 2) the corners of every loop of ``geometry``: vertices turning by more than ``CORNER_ANGLE`` (the
+    chords of a circle turn by far less)."""
+    return np.concatenate([loop[_turning_angles(loop) > CORNER_ANGLE] for loop in geometry.loops()])
+
+
 def _resample_loop(loop: np.ndarray, h: float) -> np.ndarray:
     """Points along a closed loop at spacing about h, keeping its corners."""
-    nxt = np.roll(loop, -1, axis=0)
-    prv = np.roll(loop, 1, axis=0)
-    a, b = loop - prv, nxt - loop
-    turn = np.abs(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1)))
-    corners = np.flatnonzero(turn > CORNER_ANGLE)
+    b = np.roll(loop, -1, axis=0) - loop
+    corners = np.flatnonzero(_turning_angles(loop) > CORNER_ANGLE)
     if len(corners) == 0:
         corners = np.array([0])
     seg = np.linalg.norm(b, axis=1)
@@ -130,8 +142,8 @@ def _read_nodes(geometry: Geometry, path: Path) -> np.ndarray:
 
 
 def check_nodes_inside(geometry: Geometry, nodes: np.ndarray, tol: float) -> None:
-    """Every node of ``nodes`` (n, 2) must lie in the body or within ``tol`` of its boundary, and no two coincide;
-    a ProblemError naming them otherwise."""
+    """Every node of ``nodes`` (n, 2) must lie in the body or within ``tol`` of its boundary, no two coincide and
+    every corner of the geometry is a node (within ``tol``); a ProblemError naming them otherwise."""
     out = np.flatnonzero(geometry.distance_outside(nodes) > tol)
     if len(out):
         first = ", ".join(f"#{i} ({nodes[i, 0]:g}, {nodes[i, 1]:g})" for i in out[:5])
@@ -143,6 +155,12 @@ def check_nodes_inside(geometry: Geometry, nodes: np.ndarray, tol: float) -> Non
     if len(same):
         raise ProblemError(f"{len(same)} node(s) coincide with another, e.g. #{same[0]} "
                            f"({nodes[same[0], 0]:g}, {nodes[same[0], 1]:g})", key="nodes")
+    corners = geometry_corners(geometry)
+    far = np.flatnonzero(cKDTree(nodes).query(corners)[0] > tol)
+    if len(far):
+        x, y = corners[far[0]]
+        raise ProblemError(f"{len(far)} corner(s) of the geometry have no node, e.g. ({x:g}, {y:g}): the boundary "
+                           "would cut them off; add them to the nodes", key="nodes")
 
 
 def mean_node_spacing(area: float, n_nodes: int) -> float:

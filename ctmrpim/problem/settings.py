@@ -24,6 +24,9 @@ LINEAR_SOLVERS = ("auto", "banded", "superlu", "spsolve")
 FORMULATIONS = ("updated-lagrangian", "total-lagrangian")
 #: integration schemes: the paper's CTM, and CTM with variationally consistent test gradients (VCI)
 INTEGRATIONS = ("ctm", "ctm-vci")
+#: ``method.integration`` where the file does not set it, by analysis: the consistent scheme where it is
+#: implemented (linear analyses), the paper's elsewhere
+DEFAULT_INTEGRATION = {"linear": "ctm-vci"}
 #: the order of the VCI correction: the integration constraints it makes hold
 CORRECTIONS = ("linear", "quadratic")
 #: how a strength-reduction level is equilibrated
@@ -86,7 +89,8 @@ class Method:
     min_support: int = 0                 # explicit dynamics: widen a support holding fewer nodes than this to
                                          # its min_support nearest (a thinning flow front); 0 = r_c alone
     integration: str = "ctm"             # "ctm": the paper's; "ctm-vci": test gradients corrected so that the
-                                         # integration constraints hold (linear analyses)
+                                         # integration constraints hold (linear analyses; a problem file's
+                                         # default is by analysis: DEFAULT_INTEGRATION)
     correction: str = "quadratic"        # ctm-vci: linear or quadratic integration constraints
 
     def __post_init__(self) -> None:

@@ -2,7 +2,8 @@
 
 field nodes --alpha shape--> boundary loops --CTM--> integration points and weights
             --boundary Gauss--> traction points --RPIM--> sparse shape functions
-            --assembly--> K, F --direct constraints + sparse LU--> U --> stresses, probes, errors
+            --assembly--> K, F --direct constraints + sparse LU--> U --> stresses at the integration points
+            --moving least squares--> nodal and probe stresses; errors
 """
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import scipy.sparse as sp
 from ctmrpim.discretisation import assembly, consistent_integration
 from ctmrpim.discretisation.configuration import BoundaryTags, Configuration, boundary_tags, reference_configuration
 from ctmrpim.discretisation.ctm import integration_points
+from ctmrpim.discretisation.stress_recovery import recovered_stress
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
 from ctmrpim.reference.error_norms import relative_errors
@@ -31,8 +33,9 @@ def consistent_stiffness(case: Case, conf: Configuration, tags: BoundaryTags, D:
     """K (2n x 2n) of ``method.integration = "ctm-vci"``: Petrov-Galerkin with the corrected test gradients,
     minus the Dirichlet consistency term (:mod:`ctmrpim.discretisation.consistent_integration`)."""
     if case.method.boundary != "alpha":
-        raise ProblemError("method.integration = \"ctm-vci\" integrates over the node loops of the tracked "
-                           "boundary; set method.boundary = \"alpha\"", key="method.integration")
+        raise ProblemError("method.integration = \"ctm-vci\" (the default of linear analyses) integrates over the "
+                           "node loops of the tracked boundary: set method.boundary = \"alpha\", or "
+                           "method.integration = \"ctm\" for the paper's scheme", key="method.integration")
     boundary = consistent_integration.boundary_quadrature(conf.x, conf.boundary.edges)
     sf_b = conf.shape_functions_at(boundary.points)
     thickness = case.problem.thickness
@@ -59,6 +62,8 @@ def solve_ctmrpim(case: Case) -> Result:
     F = assembly.load_vector(N_traction, traction_q.weights * problem.thickness, tags.tx, tags.ty)
     F += problem.thickness * conf.point_forces(problem)
     F += assembly.body_force_vector(sf.N, conf.w, problem)
+    if problem.body_load is not None:
+        F += assembly.load_vector(sf.N, conf.w, *problem.body_load.at(conf.points).T)
     timer.lap("assembly")
 
     # K of the consistent scheme is not symmetric: no Cholesky
@@ -67,14 +72,14 @@ def solve_ctmrpim(case: Case) -> Result:
     u = U.reshape(-1, 2)
     timer.lap("solve")
 
-    sf_n = conf.shape_functions_at(nodes)
-    stress = assembly.strain(sf_n.dNdx, sf_n.dNdy, u) @ D.T
+    # stresses are recovered from the integration points': a raw D B(x) u oscillates at boundaries
+    point_stress = assembly.strain(sf.dNdx, sf.dNdy, u) @ D.T
+    stress = recovered_stress(nodes, conf.points, conf.w, point_stress, d_c)
     probes = {}
     if problem.probes:
         pp = np.array([[p.x, p.y] for p in problem.probes])
-        sf_p = conf.shape_functions_at(pp)
-        up = sf_p.N @ u
-        sp_ = assembly.strain(sf_p.dNdx, sf_p.dNdy, u) @ D.T
+        up = conf.shape_functions_at(pp, derivatives=False).N @ u
+        sp_ = recovered_stress(pp, conf.points, conf.w, point_stress, d_c)
         probes = {p.name: probe_record(p.x, p.y, up[i], sp_[i]) for i, p in enumerate(problem.probes)}
     errors: dict = {}
     if problem.exact is not None:

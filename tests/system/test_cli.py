@@ -96,7 +96,7 @@ def test_summary_holds_the_resolved_input(run) -> None:
     assert p["method"] == {"support_radius": 4.0, "eta": 5.0, "polynomial": "linear", "line_spacing": [1 / 3, 1 / 3],
                            "gauss_points": 1, "alpha": 1.5, "boundary": "alpha", "solver": "auto",
                            "match_tolerance": 0.01, "formulation": "updated-lagrangian", "point_regeneration": 0.0,
-                           "min_support": 0, "integration": "ctm", "correction": "quadratic"}
+                           "min_support": 0, "integration": "ctm-vci", "correction": "quadratic"}
     assert p["constraint"][0]["where"] == "x == 0" and p["traction"][0]["where"] == "x == L"
     assert p["probe"] == [{"name": "tip", "at": [48.0, 0.0]}, {"name": "root_top", "at": [0.0, 6.0]}]
     d_c = math.sqrt(48.0 * 12.0) / math.sqrt(297 - 1)       # Eq. (36)
@@ -106,7 +106,7 @@ def test_summary_holds_the_resolved_input(run) -> None:
     assert s["defaults_applied"] == ["problem.gravity = [0.0, 0.0]", "method.boundary = 'alpha'", "method.solver = 'auto'",
                                      "method.match_tolerance = 0.01", "method.formulation = 'updated-lagrangian'",
                                      "method.point_regeneration = 0.0", "method.min_support = 0",
-                                     "method.integration = 'ctm'", "method.correction = 'quadratic'"]
+                                     "method.integration = 'ctm-vci'", "method.correction = 'quadratic'"]
 
 
 def test_summary_counts_timings_probes_errors(run, api) -> None:

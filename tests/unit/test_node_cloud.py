@@ -47,3 +47,38 @@ def test_boundary_nodes_on_a_large_arc_lie_on_it() -> None:
     on_arc = d < r + 0.1 * h
     assert on_arc.sum() > 40
     assert np.abs(d[on_arc] - r).max() < 1e-12 * r
+
+
+def test_a_circle_tangent_to_a_rectangle_gives_no_coincident_nodes() -> None:
+    """The union's polygon has two vertices a hair apart where the circle touches the rectangle's edge."""
+    g = Geometry(add=[Shape("rectangle", (0.0, 0.0, 2.0, 1.0)), Shape("circle", (2.0, 0.5, 0.5))])
+    nodes = make_nodes(g, NodeSpec(spacing=0.1))
+    check_nodes_inside(g, nodes, tol=1e-3)
+
+
+def test_a_node_set_without_a_corner_is_refused() -> None:
+    """A corner that is not a node would be cut off by the tracked boundary: refused, naming the corner."""
+    from ctmrpim.errors import ProblemError
+
+    g = Geometry(add=[Shape("polygon", ((0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)))])
+    nodes = make_nodes(g, NodeSpec(spacing=0.25))
+    check_nodes_inside(g, nodes, tol=1e-3)
+    without = nodes[np.hypot(nodes[:, 0] - 1.0, nodes[:, 1] - 1.0) > 1e-9]      # the re-entrant corner
+    with pytest.raises(ProblemError, match=r"corner\(s\) of the geometry have no node, e\.g\. \(1, 1\)"):
+        check_nodes_inside(g, without, tol=1e-3)
+
+
+def test_a_hole_the_cloud_cannot_resolve_is_refused(tmp_path) -> None:
+    """A hole narrower than the node spacing leaves one boundary loop: refused, never dropped silently."""
+    import ctmrpim
+    from ctmrpim.errors import ProblemError
+    from ctmrpim.problem.reader import parse_case
+
+    raw = {"problem": {"name": "p"}, "geometry": {"add": [{"rectangle": [0, 0, 2, 1]}],
+                                                  "subtract": [{"circle": [1.0, 0.5, 0.02]}]},
+           "nodes": {"spacing": 0.1}, "material": {"model": "linear-elastic", "E": 1000.0, "nu": 0.3},
+           "constraint": [{"where": "x == 0", "ux": 0, "uy": 0}], "traction": [{"where": "x == 2", "tx": 1.0}]}
+    with pytest.raises(ProblemError, match="the geometry has 2 boundary loops, the node cloud resolves 1"):
+        ctmrpim.solve(parse_case(raw, "p", tmp_path))
+    raw["geometry"]["subtract"][0]["circle"][2] = 0.12            # resolved: two loops
+    assert ctmrpim.solve(parse_case(raw, "p", tmp_path)).counts["boundary_loops"] == 2

@@ -13,7 +13,7 @@ from pathlib import Path
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.model import Problem
-from ctmrpim.problem.reader.boundary import read_boundary
+from ctmrpim.problem.reader.boundary import read_body_force, read_boundary
 from ctmrpim.problem.reader.geometry import read_geometry
 from ctmrpim.problem.reader.keys import check_keys
 from ctmrpim.problem.reader.material import read_material
@@ -67,11 +67,12 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     if not boundary.constraints and not (analysis == "explicit" and walls):
         raise ProblemError("no [[constraint]]: the body is free to move rigidly", key="constraint")
 
+    body_load = read_body_force(raw.get("body-force"), analysis, values)
     problem = Problem(name=table.name, geometry=geometry, material=material, analysis=analysis,
                       plane=table.plane, thickness=table.thickness, gravity=table.gravity,
                       parameters=values.parameters, constraints=boundary.constraints, tractions=boundary.tractions,
                       pressures=boundary.pressures, probes=boundary.probes, exact=boundary.exact,
-                      point_loads=boundary.point_loads, walls=walls)
+                      point_loads=boundary.point_loads, walls=walls, body_load=body_load)
     nodes = read_nodes(values)
     method = read_method(values, model, analysis)
     return Case(problem=problem, nodes=nodes, method=method, source=source, base_dir=base_dir,

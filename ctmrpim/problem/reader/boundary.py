@@ -1,5 +1,5 @@
 """The boundary conditions and point quantities: ``[[constraint]]``, ``[[traction]]``, ``[[pressure]]``,
-``[[probe]]``, ``[[point_load]]`` and ``[exact]``."""
+``[[probe]]``, ``[[point_load]]``, ``[exact]`` and ``[body-force]``."""
 from __future__ import annotations
 
 import math
@@ -10,7 +10,7 @@ import numpy as np
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.geometry import CIRCLE_SAGITTA, Geometry
-from ctmrpim.problem.model import Constraint, ExactSolution, PointLoad, Pressure, Probe, Traction
+from ctmrpim.problem.model import BodyForce, Constraint, ExactSolution, PointLoad, Pressure, Probe, Traction
 from ctmrpim.problem.reader.values import Values
 
 
@@ -98,3 +98,15 @@ class _Inside:
         if self.geometry.distance_outside(np.array([[x, y]]))[0] > self.tolerance:
             raise ProblemError(f"({x:g}, {y:g}) lies outside the geometry", key=key)
         return x, y
+
+
+def read_body_force(table: dict | None, analysis: str, values: Values) -> BodyForce | None:
+    """The ``[body-force]`` table: bx and by as expressions of x and y (a missing one is 0); linear analyses only."""
+    if table is None:
+        return None
+    if analysis != "linear":
+        raise ProblemError(f"[body-force] is implemented for linear analyses, not {analysis!r} (gravity is "
+                           "problem.gravity)", key="body-force")
+    if not table:
+        raise ProblemError("give bx, by or both", key="body-force")
+    return BodyForce(*(values.field(table.get(k, 0.0), f"body-force.{k}") for k in ("bx", "by")))

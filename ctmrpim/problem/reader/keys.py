@@ -24,6 +24,7 @@ SECTIONS: dict[str, set[str] | None] = {
     "probe": {"name", "at"},
     "point_load": {"at", "fx", "fy"},
     "exact": {"ux", "uy", "sxx", "syy", "sxy"},
+    "body-force": {"bx", "by"},
     "loading": set(Loading.__dataclass_fields__),
     "strength-reduction": set(StrengthReduction.__dataclass_fields__),
     "dynamic": set(Relaxation.__dataclass_fields__),

@@ -35,6 +35,8 @@ def resolve(raw: dict, problem: Problem, nodes: NodeSpec, method: Method, solvin
         "point_load": [{"at": [p.x, p.y], "fx": p.fx, "fy": p.fy} for p in problem.point_loads],
         "exact": {k: str(v) for k, v in raw.get("exact", {}).items()},
     }
+    if problem.body_load is not None:
+        resolved["body-force"] = {"bx": problem.body_load.bx.text, "by": problem.body_load.by.text}
     if problem.analysis in ("quasi-static", "strength-reduction"):
         resolved["loading"] = asdict(solving.loading)
     if solving.relaxation is not None:

@@ -12,7 +12,7 @@ from typing import Any, TypeVar, get_type_hints
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.reader.values import Values
-from ctmrpim.problem.settings import Explicit, Loading, Method, Relaxation, StrengthReduction
+from ctmrpim.problem.settings import DEFAULT_INTEGRATION, Explicit, Loading, Method, Relaxation, StrengthReduction
 
 T = TypeVar("T")
 
@@ -33,17 +33,21 @@ class Solving:
 
 
 def read_settings(cls: type[T], section: str, table: dict | None, values: Values, *,
-                  record_defaults: bool = True) -> T:
+                  record_defaults: bool = True, defaults: dict[str, Any] | None = None) -> T:
     """The settings dataclass ``cls`` from its ``table``: its numbers read as expressions, the
-    defaults of the keys not given recorded in ``values`` (unless ``record_defaults`` is false)."""
+    defaults of the keys not given (the dataclass's, or those of ``defaults`` where it has the key)
+    applied and recorded in ``values`` (unless ``record_defaults`` is false)."""
     table = table or {}
+    defaults = defaults or {}
     hints = get_type_hints(cls)
     kwargs: dict[str, Any] = {}
     for spec in fields(cls):
         key, where = spec.name, f"{section}.{spec.name}"
         if key not in table:
+            if key in defaults:
+                kwargs[key] = defaults[key]
             if record_defaults:
-                values.record(section, key, spec.default)
+                values.record(section, key, defaults.get(key, spec.default))
             continue
         value = table[key]
         if where in LISTS:
@@ -100,7 +104,8 @@ def check_loading(loading: Loading, model: str, analysis: str) -> None:
 
 def read_method(values: Values, model: str, analysis: str) -> Method:
     """The ``[method]`` table, checked against the material model and the analysis."""
-    method = read_settings(Method, "method", values.raw.get("method"), values)
+    method = read_settings(Method, "method", values.raw.get("method"), values,
+                           defaults={"integration": DEFAULT_INTEGRATION.get(analysis, "ctm")})
     if analysis == "quasi-static" and model == "linear-elastic" and method.formulation == "total-lagrangian":
         raise ProblemError("the total-Lagrangian formulation needs model = 'neo-hookean' (a linear-elastic "
                            "material at large deformation is a rate law: method.formulation = "
