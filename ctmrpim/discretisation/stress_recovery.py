@@ -29,7 +29,8 @@ from ctmrpim.errors import ProblemError
 #: fitting radius rho / d_c and polynomial order of the recovery (measured above)
 RADIUS = 2.0
 ORDER = 1
-#: a fit needs at least this many points per polynomial term
+#: a fit gathers at least this many points per polynomial term: where fewer lie within the radius (a corner
+#: under coarse integration, one point per d_c^2), its radius grows to 1.5 times the distance of the last
 POINTS_PER_TERM = 2
 
 
@@ -45,11 +46,18 @@ def recovered_stress(at: np.ndarray, points: np.ndarray, weights: np.ndarray, st
                      radius: float = RADIUS, order: int = ORDER) -> np.ndarray:
     """The recovered stress (k, c) at the k points ``at`` (k, 2) from the stresses ``stress`` (m, c) at the
     integration ``points`` (m, 2) with area ``weights`` (m,): the moving least-squares fit above, radius
-    ``radius`` d_c. A point with too few integration points in reach is an error that names it."""
-    rho = radius * d_c
+    ``radius`` d_c or more (``POINTS_PER_TERM``). Fewer integration points than that in all is an error."""
+    t = 3 if order == 1 else 6
+    need = POINTS_PER_TERM * t
+    if len(points) < need:
+        raise ProblemError(f"stress recovery: {len(points)} integration points; the fit needs {need}")
+    point_tree = cKDTree(points)
+    kth = point_tree.query(at, k=need)[0][:, -1]
+    rho_i = np.maximum(radius * d_c, 1.5 * kth)
     tree = cKDTree(at)
-    pairs = tree.sparse_distance_matrix(cKDTree(points), rho, output_type="coo_matrix")
-    i, p, r = pairs.row, pairs.col, pairs.data
+    pairs = tree.sparse_distance_matrix(point_tree, rho_i.max(), output_type="coo_matrix")
+    keep = pairs.data <= rho_i[pairs.row]
+    i, p, r = pairs.row[keep], pairs.col[keep], pairs.data[keep]
     # a sparse matrix leaves out the pairs at distance 0 (an evaluation point on an integration point): add them
     hits = np.flatnonzero(tree.query_ball_point(points, 1e-12 * d_c, return_length=True))
     if len(hits):
@@ -57,15 +65,10 @@ def recovered_stress(at: np.ndarray, points: np.ndarray, weights: np.ndarray, st
         extra_i = np.concatenate([np.asarray(c, dtype=np.intp) for c in coincident])
         extra_p = np.repeat(hits, [len(c) for c in coincident])
         i, p, r = np.r_[i, extra_i], np.r_[p, extra_p], np.r_[r, np.zeros(len(extra_i))]
-    s = r / rho
+    s = r / rho_i[i]
     kernel = weights[p] * (1 - 6 * s ** 2 + 8 * s ** 3 - 3 * s ** 4)
     P = _basis((points[p, 0] - at[i, 0]) / d_c, (points[p, 1] - at[i, 1]) / d_c, order)
-    k, t = len(at), P.shape[1]
-    count = np.bincount(i, minlength=k)
-    if count.min() < POINTS_PER_TERM * t:
-        bad = int(np.argmin(count))
-        raise ProblemError(f"stress recovery: only {count[bad]} integration points within {radius:g} d_c of "
-                           f"({at[bad, 0]:.6g}, {at[bad, 1]:.6g}); the fit needs {POINTS_PER_TERM * t}")
+    k = len(at)
     M = np.zeros((k, t, t))
     for a in range(t):
         for b in range(a, t):
