@@ -33,11 +33,11 @@ BODY = {
 }
 
 
-def _traction(where: str, nx: str, ny: str) -> dict:
-    """The exact traction sigma n on the edges ``where``, the outward normal (nx, ny) as expressions."""
-    f = FIELD
-    return {"where": where, "tx": f"({nx})*({f['sxx']}) + ({ny})*({f['sxy']})",
-            "ty": f"({nx})*({f['sxy']}) + ({ny})*({f['syy']})"}
+def exact_traction(where: str, nx: str | float, ny: str | float, field: dict) -> dict:
+    """A ``[[traction]]`` entry: the traction sigma n of ``field`` (stresses as expressions) on the edges ``where``,
+    the outward normal (nx, ny) numbers or expressions of x and y."""
+    return {"where": where, "tx": f"({nx})*({field['sxx']}) + ({ny})*({field['sxy']})",
+            "ty": f"({nx})*({field['sxy']}) + ({ny})*({field['syy']})"}
 
 
 def manufactured_case(spacing: float, method: dict | None = None) -> Case:
@@ -51,9 +51,10 @@ def manufactured_case(spacing: float, method: dict | None = None) -> Case:
            "material": {"model": "linear-elastic", "E": E, "nu": NU},
            "constraint": [{"where": "x == 0", "ux": FIELD["ux"], "uy": FIELD["uy"]},
                           {"where": f"hypot(x - {hx}, y - {hy}) == {hr}", "ux": FIELD["ux"], "uy": FIELD["uy"]}],
-           "traction": [_traction(f"y == 0 and x <= {ex}", "0", "-1"), _traction(f"y == 1 and x <= {ex}", "0", "1"),
-                        _traction(f"x == {ex} and abs(y - {ey}) >= {er}", "1", "0"),
-                        _traction(f"x >= {ex} and hypot(x - {ex}, y - {ey}) == {er}",
-                                  f"(x - {ex})/{er}", f"(y - {ey})/{er}")],
+           "traction": [exact_traction(f"y == 0 and x <= {ex}", 0, -1, FIELD),
+                        exact_traction(f"y == 1 and x <= {ex}", 0, 1, FIELD),
+                        exact_traction(f"x == {ex} and abs(y - {ey}) >= {er}", 1, 0, FIELD),
+                        exact_traction(f"x >= {ex} and hypot(x - {ex}, y - {ey}) == {er}",
+                                       f"(x - {ex})/{er}", f"(y - {ey})/{er}", FIELD)],
            "body-force": dict(BODY), "exact": dict(FIELD), "method": dict(method or {})}
     return parse_case(raw, "manufactured", Path("."))

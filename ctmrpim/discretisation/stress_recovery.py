@@ -47,24 +47,17 @@ def recovered_stress(at: np.ndarray, points: np.ndarray, weights: np.ndarray, st
     """The recovered stress (k, c) at the k points ``at`` (k, 2) from the stresses ``stress`` (m, c) at the
     integration ``points`` (m, 2) with area ``weights`` (m,): the moving least-squares fit above, radius
     ``radius`` d_c or more (``POINTS_PER_TERM``). Fewer integration points than that in all is an error."""
-    t = 3 if order == 1 else 6
+    t = (order + 1) * (order + 2) // 2            # terms of the complete polynomial (_basis)
     need = POINTS_PER_TERM * t
     if len(points) < need:
         raise ProblemError(f"stress recovery: {len(points)} integration points; the fit needs {need}")
     point_tree = cKDTree(points)
     kth = point_tree.query(at, k=need)[0][:, -1]
     rho_i = np.maximum(radius * d_c, 1.5 * kth)
-    tree = cKDTree(at)
-    pairs = tree.sparse_distance_matrix(point_tree, rho_i.max(), output_type="coo_matrix")
-    keep = pairs.data <= rho_i[pairs.row]
-    i, p, r = pairs.row[keep], pairs.col[keep], pairs.data[keep]
-    # a sparse matrix leaves out the pairs at distance 0 (an evaluation point on an integration point): add them
-    hits = np.flatnonzero(tree.query_ball_point(points, 1e-12 * d_c, return_length=True))
-    if len(hits):
-        coincident = tree.query_ball_point(points[hits], 1e-12 * d_c)
-        extra_i = np.concatenate([np.asarray(c, dtype=np.intp) for c in coincident])
-        extra_p = np.repeat(hits, [len(c) for c in coincident])
-        i, p, r = np.r_[i, extra_i], np.r_[p, extra_p], np.r_[r, np.zeros(len(extra_i))]
+    # every pair, those at distance 0 too (an evaluation point on an integration point), as plain arrays
+    pairs = cKDTree(at).sparse_distance_matrix(point_tree, rho_i.max(), output_type="ndarray")
+    pairs = pairs[pairs["v"] <= rho_i[pairs["i"]]]
+    i, p, r = pairs["i"], pairs["j"], pairs["v"]
     s = r / rho_i[i]
     kernel = weights[p] * (1 - 6 * s ** 2 + 8 * s ** 3 - 3 * s ** 4)
     P = _basis((points[p, 0] - at[i, 0]) / d_c, (points[p, 1] - at[i, 1]) / d_c, order)

@@ -74,12 +74,12 @@ def solve_ctmrpim(case: Case) -> Result:
 
     # stresses are recovered from the integration points': a raw D B(x) u oscillates at boundaries
     point_stress = assembly.strain(sf.dNdx, sf.dNdy, u) @ D.T
-    stress = recovered_stress(nodes, conf.points, conf.w, point_stress, d_c)
+    pp = np.array([[p.x, p.y] for p in problem.probes]).reshape(-1, 2)
+    recovered = recovered_stress(np.r_[nodes, pp], conf.points, conf.w, point_stress, d_c)   # one fit for both
+    stress, sp_ = recovered[:len(nodes)], recovered[len(nodes):]
     probes = {}
     if problem.probes:
-        pp = np.array([[p.x, p.y] for p in problem.probes])
         up = conf.shape_functions_at(pp, derivatives=False).N @ u
-        sp_ = recovered_stress(pp, conf.points, conf.w, point_stress, d_c)
         probes = {p.name: probe_record(p.x, p.y, up[i], sp_[i]) for i, p in enumerate(problem.probes)}
     errors: dict = {}
     if problem.exact is not None:

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from manufactured import exact_traction
 from verify import check
 
 import ctmrpim
@@ -28,13 +29,6 @@ LINEAR_FIELD = {"ux": f"{EXX}*x + {GXY / 2}*y", "uy": f"{GXY / 2}*x + {EYY}*y",
 C = 1e-3
 QUADRATIC_FIELD = {"ux": f"{C}*x*y", "uy": "0*x", "sxx": f"{A * C}*y", "syy": f"{NU * A * C}*y", "sxy": f"{G * C}*x"}
 QUADRATIC_GRAVITY = [0.0, -(G * C + NU * A * C)]
-
-
-def _traction(where: str, nx: float, ny: float, f: dict) -> dict:
-    """The exact traction sigma n on the edges ``where`` with outward normal (nx, ny)."""
-    tx = f"({nx})*({f['sxx']}) + ({ny})*({f['sxy']})"
-    ty = f"({nx})*({f['sxy']}) + ({ny})*({f['syy']})"
-    return {"where": where, "tx": tx, "ty": ty}
 
 
 def _edges(kind: str) -> list[tuple[str, float, float]]:
@@ -59,7 +53,7 @@ def patch_case(kind: str, field: dict, method: dict, nodes: dict | None = None, 
            "geometry": geometry, "nodes": nodes or {"spacing": 0.1},
            "material": {"model": "linear-elastic", "E": E, "nu": NU, "density": 1.0},
            "constraint": [{"where": "x == 0", "ux": field["ux"], "uy": field["uy"]}],
-           "traction": [_traction(w, nx, ny, field) for w, nx, ny in _edges(kind)],
+           "traction": [exact_traction(w, nx, ny, field) for w, nx, ny in _edges(kind)],
            "exact": dict(field), "method": dict(method)}
     return parse_case(raw, f"patch-{kind}", Path("."))
 
