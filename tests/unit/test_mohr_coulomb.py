@@ -214,8 +214,11 @@ def test_every_return_region_occurs() -> None:
     assert set(np.unique(region)) == {ELASTIC, MAIN, RIGHT, LEFT, APEX}
 
 
+#: tension at most 0.99 c, below Mohr-Coulomb's apex c cot(phi) >= c (phi <= 45 deg): at the apex itself the
+#: cut-off is Mohr-Coulomb's tip and never binds, so the properties below are vacuous there (Hypothesis found
+#: phi = 45 deg, tension = c: no point in the cut-off region; at 0.99 c, 226 of 400)
 cut_off_materials = st.builds(lambda phi, dpsi, t: MohrCoulomb(E=E, nu=NU, c=C, phi=phi, psi=phi * dpsi, tension=t * C),
-                              st.floats(0.001, 45.0), st.floats(0.0, 1.0), st.floats(0.0, 1.0))
+                              st.floats(0.001, 45.0), st.floats(0.0, 1.0), st.floats(0.0, 0.99))
 
 
 def tensile_cloud(seed: int, m: int = 400):
