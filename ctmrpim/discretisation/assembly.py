@@ -4,9 +4,9 @@ Degrees of freedom are interleaved: node i owns dofs 2i (u_x) and 2i+1 (u_y). Th
 built from sparse products of the derivative matrices, K = B^T (w D) B (the paper's Eq. 7 lacks the
 transpose on B; Eq. 9's form is used), never by scattering a dense block per integration point.
 
-With z = dN/dx + i dN/dy per point and node, two complex products give every sum the stiffness
-needs: Z^T W Z = (xx - yy) + i (xy + yx) and Z^H W Z = (xx + yy) + i (xy - yx), where
-xy_ij = sum_p w_p dN_i/dx dN_j/dy. That is a third less work than three real products, and the
+With z = dN/dx + i dN/dy per point and node (z~ likewise from the test gradients), two complex products
+give every sum the stiffness needs: Z~^T W Z = (xx - yy) + i (xy + yx) and Z~^H W Z = (xx + yy) + i (xy - yx),
+where xy_ij = sum_p w_p dN~_i/dx dN_j/dy. That is a third less work than three real products, and the
 four 2 x 2 block entries of every node pair then share one sparsity pattern (a BSR matrix).
 """
 from __future__ import annotations
@@ -22,16 +22,20 @@ def dof(node: np.ndarray, component: int) -> np.ndarray:
     return 2 * np.asarray(node) + component
 
 
-def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: np.ndarray) -> sp.csr_matrix:
-    """K (2n x 2n) = sum_p B_p^T D B_p w_p (Eq. 5) from the derivatives ``dNdx``, ``dNdy`` (m, n) at m points
+def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: np.ndarray,
+              test: tuple[sp.csr_matrix, sp.csr_matrix] | None = None) -> sp.csr_matrix:
+    """K (2n x 2n) = sum_p B~_p^T D B_p w_p (Eq. 5) from the derivatives ``dNdx``, ``dNdy`` (m, n) at m points
     with ``weights`` (m,), for one constant D (3, 3) with D[0, 2] = D[1, 2] = 0 (isotropic or orthotropic in
-    its axes); rows and columns of dNdx and dNdy must share one sparsity pattern."""
+    its axes). B~ is built from the ``test`` gradients (d~N/dx, d~N/dy) where given (Petrov-Galerkin, not
+    symmetric: :mod:`ctmrpim.discretisation.consistent_integration`), else B~ = B. All matrices must share
+    one sparsity pattern."""
     _check_axes(D)
     n = dNdx.shape[1]
-    z = dNdx.data + 1j * dNdy.data
+    tdx, tdy = test if test is not None else (dNdx, dNdy)
     rows = np.repeat(np.arange(dNdx.shape[0]), np.diff(dNdx.indptr))
-    wZ = sp.csr_matrix((z * weights[rows], dNdx.indices, dNdx.indptr), shape=dNdx.shape)
-    ZT = sp.csr_matrix((z, dNdx.indices, dNdx.indptr), shape=dNdx.shape).T.tocsr()
+    wZ = sp.csr_matrix(((dNdx.data + 1j * dNdy.data) * weights[rows], dNdx.indices, dNdx.indptr), shape=dNdx.shape)
+    t = tdx.data + 1j * tdy.data
+    ZT = sp.csr_matrix((t, tdx.indices, tdx.indptr), shape=tdx.shape).T.tocsr()
     ZHT = sp.csr_matrix((ZT.data.conj(), ZT.indices, ZT.indptr), shape=ZT.shape)
     p1 = ZT @ wZ
     p2 = ZHT @ wZ
@@ -47,26 +51,6 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     yy = 0.5 * (d2.real - d1.real)
     xy = 0.5 * (d1.imag + d2.imag)
     yx = 0.5 * (d1.imag - d2.imag)
-    return _block_stiffness(pattern, xx, xy, yx, yy, D, n)
-
-
-def petrov_galerkin_stiffness(test_dx: sp.csr_matrix, test_dy: sp.csr_matrix, dNdx: sp.csr_matrix,
-                              dNdy: sp.csr_matrix, weights: np.ndarray, D: np.ndarray) -> sp.csr_matrix:
-    """K (2n x 2n) = sum_p B~_p^T D B_p w_p with the test gradients ``test_dx``, ``test_dy`` and the trial
-    gradients ``dNdx``, ``dNdy`` (all (m, n) on one sparsity pattern) at m points with ``weights`` (m,);
-    not symmetric (:mod:`ctmrpim.discretisation.consistent_integration`). D as in :func:`stiffness`."""
-    _check_axes(D)
-    n = dNdx.shape[1]
-    rows = np.repeat(np.arange(dNdx.shape[0]), np.diff(dNdx.indptr))
-    scaled = [sp.csr_matrix((M.data * weights[rows], M.indices, M.indptr), shape=M.shape) for M in (dNdx, dNdy)]
-    tx, ty = test_dx.T.tocsr(), test_dy.T.tocsr()
-    products = [tx @ scaled[0], tx @ scaled[1], ty @ scaled[0], ty @ scaled[1]]    # xx, xy, yx, yy
-    pattern = abs(products[0])
-    for p in products[1:]:
-        pattern = pattern + abs(p)
-    pattern = pattern.tocsr()
-    pattern.sort_indices()
-    xx, xy, yx, yy = (_on_pattern(p.tocsr(), pattern) for p in products)
     return _block_stiffness(pattern, xx, xy, yx, yy, D, n)
 
 

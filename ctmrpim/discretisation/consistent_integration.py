@@ -19,7 +19,7 @@ on the points of the node's support:
 
 The stiffness is then Petrov-Galerkin, K_IJ = sum_p w_p B~_I^T D B_J (the trial gradients stay: correcting
 them too breaks the rigid-body cancellation), assembled by
-:func:`ctmrpim.discretisation.assembly.petrov_galerkin_stiffness`, and tractions are integrated on the
+:func:`ctmrpim.discretisation.assembly.stiffness`, and tractions are integrated on the
 same boundary Gauss points as the correction. On an edge with a prescribed displacement component the
 test functions of free nodes do not vanish between the edge's nodes, so the unknown reaction is
 written as the traction of the discrete solution, t = sigma(u_h) n: :func:`dirichlet_consistency`

@@ -41,7 +41,7 @@ def consistent_stiffness(case: Case, conf: Configuration, tags: BoundaryTags, D:
     thickness = case.problem.thickness
     test_dx, test_dy = consistent_integration.corrected_gradients(
         conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf, boundary, sf_b.N, case.method.correction)
-    K = assembly.petrov_galerkin_stiffness(test_dx, test_dy, conf.sf.dNdx, conf.sf.dNdy, conf.w, D)
+    K = assembly.stiffness(conf.sf.dNdx, conf.sf.dNdy, conf.w, D, test=(test_dx, test_dy))
     return K - consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, boundary, sf_b, D, thickness)
 
 
