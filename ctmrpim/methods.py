@@ -17,6 +17,7 @@ from typing import Any, Callable
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
+from ctmrpim.problem.size_estimate import check_fits
 from ctmrpim.result import Result
 from ctmrpim.run_options import RunOptions
 
@@ -84,6 +85,7 @@ def solve(case: Case, method: str = DEFAULT, element: str | None = None, *,
     progress bar with ``progress_bar``. An element the method does not offer is refused."""
     entry = get(method)
     element = element_of(entry, element)
+    check_fits(case, method)      # before anything is allocated: a clear refusal, not an allocation error
     options = RunOptions(progress=progress or (lambda level: None), out=out, resume=resume,
                          progress_bar=progress_bar)
     return entry.solve(case, element, options)

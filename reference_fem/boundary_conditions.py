@@ -11,6 +11,7 @@ from skfem.assembly.basis import AbstractBasis
 from skfem.mesh import Mesh
 
 from ctmrpim.errors import ProblemError
+from ctmrpim.problem import supports
 from ctmrpim.problem.expressions import Field
 from ctmrpim.problem.model import Problem
 from reference_fem.mesh import FemMesh
@@ -68,10 +69,12 @@ def field_values(f: Field | None, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def constrained_dofs(problem: Problem, fm: FemMesh, basis: AbstractBasis,
-                      tol: float) -> tuple[np.ndarray, np.ndarray]:
+                     tol: float) -> tuple[np.ndarray, np.ndarray]:
     """Fixed DOFs and their values: vertex DOFs at selected boundary vertices, plus (P2) the midside
-    DOFs of facets whose both ends are selected; a later constraint overrides an earlier one."""
-    dofs, vals = [], []
+    DOFs of facets whose both ends are selected. Constraints that disagree at a DOF, a load that acts only
+    on prescribed displacements and (static analyses) constraints that leave a part of the body a rigid-body
+    motion are refused, as for CTM-RPIM (:mod:`ctmrpim.problem.supports`)."""
+    prescribed = []
     for i, c in enumerate(problem.constraints):
         verts, facets = selected_facets(c.where, fm, tol)
         if len(verts) == 0:
@@ -83,12 +86,14 @@ def constrained_dofs(problem: Problem, fm: FemMesh, basis: AbstractBasis,
             d = basis.nodal_dofs[comp, verts]
             if basis.facet_dofs.size:
                 d = np.concatenate([d, basis.facet_dofs[comp, facets]])
-            dofs.append(d)
-            vals.append(f(basis.doflocs[0, d], basis.doflocs[1, d]))
-    dofs_all = np.concatenate(dofs)[::-1]
-    vals_all = np.concatenate(vals)[::-1]
-    fixed, first = np.unique(dofs_all, return_index=True)   # first of the reversed = last given
-    return fixed, vals_all[first]
+            at = basis.doflocs[:, d]
+            prescribed.append(supports.Prescribed(i, d, at.T, np.full(len(d), comp), f(at[0], at[1])))
+    fixed, values, positions, components = supports.merge(prescribed)
+    mesh = fm.mesh
+    bverts = np.unique(mesh.facets[:, mesh.boundary_facets()])
+    supports.check_loads_on_supports(problem, mesh.p[0, bverts], mesh.p[1, bverts], tol)
+    supports.check_rigid_motion(problem, positions, components, tol)
+    return fixed, values
 
 
 def locate(mesh: Mesh, point: np.ndarray, d_c: float, name: str) -> np.ndarray:

@@ -93,8 +93,10 @@ def alpha_shape(points: np.ndarray, alpha: float, d_c: float, reference: np.ndar
         raise ProblemError(f"alpha shape: {len(points)} node(s) cannot enclose an area")
     try:
         dt = Delaunay(points)
-    except QhullError:
-        raise ProblemError("alpha shape: the nodes are collinear or coincide; they enclose no area") from None
+    except QhullError as exc:
+        raise ProblemError(_qhull_failure(points, exc)) from None
+    except MemoryError:
+        raise ProblemError(f"alpha shape: out of memory triangulating {len(points)} nodes") from None
     tri = dt.simplices.copy()
     a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
     cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
@@ -203,3 +205,14 @@ def validate(boundary: Boundary, expected_area: float | None = None, area_tol: f
     if expected_area is not None and area_tol is not None and abs(boundary.area - expected_area) > area_tol:
         raise ProblemError(f"alpha shape encloses {boundary.area:.6g}, expected {expected_area:.6g} "
                            f"(tolerance {area_tol:.3g}); adjust method.alpha")
+
+
+def _qhull_failure(points: np.ndarray, exc: Exception) -> str:
+    """What a Qhull failure means: a degenerate cloud (collinear or coincident nodes) where it is one,
+    else Qhull's own first line (a resource limit, a precision problem) with the node count."""
+    centred = points - points.mean(axis=0)
+    s = np.linalg.svd(centred, compute_uv=False)
+    if s[-1] <= 1e-12 * max(s[0], 1e-300):
+        return "alpha shape: the nodes are collinear or coincide; they enclose no area"
+    first = next((line.strip() for line in str(exc).splitlines() if line.strip()), type(exc).__name__)
+    return f"alpha shape: Qhull failed to triangulate {len(points)} nodes ({first})"

@@ -3,8 +3,8 @@
 Selectors are evaluated once, on the reference configuration: constraints select boundary nodes,
 tractions and pressures select boundary segments whose two end nodes both match (so a corner node
 alone never loads the adjacent face). A selector that matches nothing is an error, and so is a
-prescribed value that is not a finite number (``9**9**9`` evaluates to inf) or a part of the body
-without any constrained node (its stiffness is singular; the sparse solver does not always notice).
+prescribed value that is not a finite number (``9**9**9`` evaluates to inf), and so are supports that
+conflict or leave a rigid-body motion free (:mod:`ctmrpim.problem.supports`).
 """
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ from scipy.sparse.csgraph import connected_components
 from ctmrpim.discretisation.assembly import dof
 from ctmrpim.discretisation.ctm import BoundaryQuadrature, boundary_points
 from ctmrpim.errors import ProblemError
+from ctmrpim.problem import supports
 from ctmrpim.problem.expressions import Field
 from ctmrpim.problem.model import Problem
 
@@ -24,9 +25,10 @@ TRACTION_GAUSS_POINTS = 3  # per boundary segment; exact for the cantilever's pa
 
 def constrained_dofs(problem: Problem, nodes: np.ndarray, boundary_nodes: np.ndarray,
                      tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """Fixed dofs (interleaved: 2 node + component) and their values; a later constraint overrides an
-    earlier one."""
-    values: dict[int, float] = {}
+    """Fixed dofs (interleaved: 2 node + component) and their values. Constraints that disagree at a node,
+    a load that acts only on prescribed displacements, and (static analyses) constraints that leave a part of
+    the body a rigid-body motion are refused (:mod:`ctmrpim.problem.supports`)."""
+    prescribed = []
     bx, by = nodes[boundary_nodes, 0], nodes[boundary_nodes, 1]
     for i, c in enumerate(problem.constraints):
         sel = boundary_nodes[np.asarray(c.where(bx, by, eq_tol=tol), bool)]
@@ -35,19 +37,27 @@ def constrained_dofs(problem: Problem, nodes: np.ndarray, boundary_nodes: np.nda
         for comp, f in ((0, c.ux), (1, c.uy)):
             if f is not None:
                 v = _values(f, nodes[sel, 0], nodes[sel, 1], f"constraint[{i}].{'uy' if comp else 'ux'}")
-                values.update(zip(dof(sel, comp).tolist(), v.tolist()))
-    dofs = np.fromiter(values.keys(), int, len(values))
-    vals = np.fromiter(values.values(), float, len(values))
+                prescribed.append(supports.Prescribed(i, dof(sel, comp), nodes[sel], np.full(len(sel), comp), v))
+    dofs, vals, positions, components = supports.merge(prescribed)
+    supports.check_loads_on_supports(problem, bx, by, tol)
+    if problem.analysis in supports.STATIC_ANALYSES:
+        supports.check_rigid_motion(problem, positions, components, tol)
+    else:
+        _check_parts_held(problem, nodes[np.unique(dofs // 2)], tol)
+    return dofs, vals
+
+
+def _check_parts_held(problem: Problem, held_nodes: np.ndarray, tol: float) -> None:
+    """Explicit dynamics may hold a body by walls alone, but a part without any constrained node among
+    constrained ones is a mistake of the selectors (a detached piece would fall through the supports)."""
     parts = problem.geometry.polygons
     if len(parts) > 1:  # one loop per part of the body, not per node
-        held = shapely.points(nodes[np.unique(dofs // 2)])
+        held = shapely.points(held_nodes)
         for k, part in enumerate(parts):
             if not (shapely.distance(part, held) <= tol).any():
                 x0, y0, x1, y1 = part.bounds
                 raise ProblemError(f"part {k + 1} of the body, within ({x0:g}, {y0:g}) .. ({x1:g}, {y1:g}), has no "
                                    "constrained node: it is free to move rigidly", key="constraint")
-    order = np.argsort(dofs)
-    return dofs[order], vals[order]
 
 
 def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol: float

@@ -46,7 +46,7 @@ def test_cantilever_benchmark() -> None:
     p = case.problem
     assert p.name == "cantilever" and p.analysis == "linear" and p.plane == "stress" and p.thickness == 1.0
     assert p.parameters == {"P": -1000.0, "E": 3.0e7, "nu": 0.3, "L": 48.0, "W": 12.0, "I": 144.0}
-    assert (p.material.E, p.material.nu, p.material.density) == (3.0e7, 0.3, 1.0)
+    assert (p.material.E, p.material.nu, p.material.density) == (3.0e7, 0.3, 0.0)
     assert p.geometry.bounds == (0.0, -6.0, 48.0, 6.0) and p.geometry.is_rectangle()
     assert p.geometry.area == 576.0
     assert case.nodes == NodeSpec(grid=(33, 9))

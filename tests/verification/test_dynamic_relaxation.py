@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.sparse.linalg import spsolve
 
 from ctmrpim import benchmarks
@@ -9,6 +10,7 @@ from ctmrpim.solvers.elastoplastic import ctm_plastic_system
 from ctmrpim.timing import Timer
 
 
+@pytest.mark.filterwarnings(r"ignore:\[exact\] is not compared:UserWarning")
 def test_dynamic_relaxation_comes_to_rest_at_the_elastic_solution() -> None:
     """A strong Mohr-Coulomb column under its own weight stays elastic: relaxed to rest it matches the
     linear solve of the same CTM-RPIM discretisation (the exact K0 column within the method's error)."""

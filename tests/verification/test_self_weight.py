@@ -18,6 +18,7 @@ def test_self_weight_ctmrpim_and_fem(solutions) -> None:
     check("self-weight-fem-p2-top", solve(case, "fem", "p2").errors["probes"]["top"]["uy"])
 
 
+@pytest.mark.filterwarnings(r"ignore:\[exact\] is not compared:UserWarning")
 def test_mohr_coulomb_column_under_gravity_stays_elastic_and_matches(solutions) -> None:
     """A strong Mohr-Coulomb column takes the same K0 state as the linear solve, in one increment."""
     elastic = solutions("self-weight", ['method.integration="ctm"'])     # the plastic solvers' scheme

@@ -14,6 +14,7 @@ from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.model import Problem
 from ctmrpim.problem.reader.boundary import read_body_force, read_boundary
+from ctmrpim.problem.reader.effects import check_effects
 from ctmrpim.problem.reader.geometry import read_geometry
 from ctmrpim.problem.reader.keys import check_keys
 from ctmrpim.problem.reader.material import read_material
@@ -32,9 +33,16 @@ def read_case(path: str | Path, overrides: list[str] | None = None) -> Case:
     """The case of the problem file at ``path``, with ``--set`` ``overrides`` applied; errors name the file."""
     path = Path(path)
     try:
-        text = path.read_text()
+        data = path.read_bytes()
     except OSError as exc:
         raise ProblemError(f"cannot read problem file ({exc.strerror})", source=str(path)) from None
+    try:
+        text = data.decode("utf-8")   # TOML is UTF-8 by definition, whatever the locale says
+    except UnicodeDecodeError as exc:
+        bom = " (it starts with a UTF-16 byte-order mark)" if data[:2] in (b"\xff\xfe", b"\xfe\xff") else ""
+        line = data[:exc.start].count(b"\n") + 1
+        raise ProblemError(f"not UTF-8 text{bom}: byte 0x{data[exc.start]:02x} on line {line}; TOML files are "
+                           "UTF-8, save it as UTF-8", source=str(path)) from None
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -63,6 +71,7 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
     check_walls_allowed(raw, analysis)
     check_loading(solving.loading, model, analysis)
     boundary = read_boundary(geometry, analysis, values)
+    check_effects(raw, table, model, material.density)
     walls = read_walls(values)
     if not boundary.constraints and not (analysis == "explicit" and walls):
         raise ProblemError("no [[constraint]]: the body is free to move rigidly", key="constraint")

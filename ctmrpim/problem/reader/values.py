@@ -4,7 +4,7 @@ from __future__ import annotations
 from typing import Any
 
 from ctmrpim.errors import ProblemError
-from ctmrpim.problem.expressions import Field, constant
+from ctmrpim.problem.expressions import CONSTANTS, FUNCTIONS, Field, constant
 
 
 def read_parameters(table: dict) -> dict[str, float]:
@@ -15,6 +15,10 @@ def read_parameters(table: dict) -> dict[str, float]:
             raise ProblemError(f"{name!r} is not a valid name", key=f"parameters.{name}")
         if name in ("x", "y", "t"):
             raise ProblemError(f"{name!r} is reserved for the coordinates and time", key=f"parameters.{name}")
+        if name in CONSTANTS or name in FUNCTIONS:
+            # it would silently replace the constant (pi, e) or hide the function in every expression
+            what = f"the constant {name} = {CONSTANTS[name]:.6g}" if name in CONSTANTS else f"the function {name}()"
+            raise ProblemError(f"{name!r} would replace {what}: choose another name", key=f"parameters.{name}")
         try:
             params[name] = constant(value, params)
         except ProblemError as exc:

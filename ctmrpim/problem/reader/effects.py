@@ -1,0 +1,59 @@
+"""Settings that would be silently without effect: refused with one line, or warned about where the
+setting is harmless and common (a density in a problem without gravity).
+
+The rule: nothing the user wrote is silently without effect. The checks here need the whole file
+(a key's effect depends on the analysis and the material model); those that need the nodes
+(conflicting constraints, a load on a constrained edge, too few supports) are made where the
+selectors are evaluated (:mod:`ctmrpim.discretisation.boundary_conditions`).
+"""
+from __future__ import annotations
+
+import warnings
+
+from ctmrpim.errors import ProblemError
+from ctmrpim.problem.reader.problem_table import ProblemTable
+
+#: [material] keys only the Mohr-Coulomb model reads
+MOHR_COULOMB_KEYS = ("c", "phi", "psi", "tension")
+#: analyses that read [loading] (Newton's load stepping; strength reduction's levels)
+LOADING_ANALYSES = ("quasi-static", "strength-reduction")
+#: analyses in which the density only enters through gravity (no inertia)
+STATIC_ANALYSES = ("linear", "quasi-static")
+
+
+def check_effects(raw: dict, table: ProblemTable, model: str, density: float) -> None:
+    """Raise (or warn) for a setting of the parsed file ``raw`` that would have no effect in its analysis
+    (``table``) with its material ``model`` and ``density``."""
+    analysis = table.analysis
+    material = raw.get("material", {})
+    for key in MOHR_COULOMB_KEYS:
+        if key in material and model != "mohr-coulomb":
+            raise ProblemError(f"{key} is read only by model = \"mohr-coulomb\", not by {model!r}: remove it",
+                               key=f"material.{key}")
+    if "loading" in raw and analysis not in LOADING_ANALYSES:
+        raise ProblemError(f"[loading] has no effect in a {analysis!r} analysis (it steps the loads of "
+                           "\"quasi-static\" and \"strength-reduction\" analyses): remove it", key="loading")
+    if any(table.gravity):
+        if density == 0:
+            raise ProblemError(f"gravity = {list(table.gravity)} has no effect with material.density = 0 (the body "
+                               "force is density x gravity): set material.density", key="material.density")
+        if analysis == "quasi-static" and model != "mohr-coulomb":
+            raise ProblemError("gravity is not in the large-deformation solvers (a Mohr-Coulomb or linear analysis "
+                               "takes it): remove problem.gravity", key="problem.gravity")
+    elif "density" in material and density != 0 and analysis in STATIC_ANALYSES:
+        warnings.warn(f"material.density = {density:g} has no effect in a {analysis} analysis without "
+                      "problem.gravity", UserWarning, stacklevel=2)
+    exact = raw.get("exact")
+    if exact is not None:
+        if analysis != "linear":
+            # a benchmark keeps its exact solution when an analysis is switched by --set (the tests compare
+            # a relaxed or stepped solution with it themselves): say it, do not refuse it
+            warnings.warn(f"[exact] is not compared in a {analysis!r} analysis (only linear analyses report "
+                          "errors)", UserWarning, stacklevel=2)
+        for group, what in ((("ux", "uy"), "the displacement (L2 error, probes)"),
+                            (("sxx", "syy", "sxy"), "the stress (energy error)")):
+            given = [k for k in group if k in exact]
+            if given and len(given) < len(group):
+                missing = [k for k in group if k not in exact]
+                raise ProblemError(f"{' and '.join(missing)} missing: {what} is compared only when "
+                                   f"{', '.join(group[:-1])} and {group[-1]} are all given", key="exact")
