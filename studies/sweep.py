@@ -3,19 +3,33 @@
 Every case gets a folder under the sweep's root named by a hash of its *resolved* input (the full
 problem after defaults and overrides, the solver and element, and the version of the code that
 computes it, so that changed code never serves a stale cached result), holding
-``summary.json`` and ``status.json`` (start, end, status, error). A case counts as done when its
-status is ``ok`` with the same hash: a re-run skips it, so an interrupted sweep resumes where it
-stopped; a failed case keeps its error and is retried only when asked (``retry_failed``).
+``summary.json`` and ``status.json`` (start, end, status, error) and, for explicit runs, the time
+series. A case counts as done when its status is ``ok`` with the same hash: a re-run skips it, so an
+interrupted sweep resumes where it stopped. A case that failed (status ``error``: bad settings, a
+diverged solve) keeps its error and is retried only when asked (``retry_failed``); one that could
+not run where it was sent (status ``failed``: a worker of another code version, a worker that died)
+is retried on every run, and the sweep ends with a :class:`ProblemError` naming the cause, since its
+table would have holes for a reason that is not the case's.
 
 Local runs use a process pool (``workers``, one BLAS thread and one RPIM thread per worker so that
-P workers do not fight over the cores); ``scheduler="tcp://..."`` sends the same work to a
-``dask.distributed`` cluster instead. Post-processing reads the case folders and can be redone alone.
+P workers do not fight over the cores) whose workers write each case folder in place.
+``scheduler="tcp://..."`` sends the same work to a ``dask.distributed`` cluster instead (start the
+workers with ``--nthreads 1``). Workers there run in folders of their own, often on other machines,
+so a Dask worker solves in a scratch folder and returns the status record and every file the case
+wrote; the client writes them into the case folder. The client loads each case itself and sends the
+resolved :class:`Case`, so the worker computes exactly what was hashed, and sends the code version it
+hashed; a worker whose own version differs refuses the case (status ``failed``, both versions named).
+Cases that read files at solve time (a node file) need them at the same path on the workers.
+Post-processing reads the case folders and can be redone alone.
 """
 from __future__ import annotations
 
 import hashlib
 import json
+import shutil
+import socket
 import sys
+import tempfile
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -23,14 +37,17 @@ from dataclasses import asdict, dataclass, field
 from functools import cache
 from multiprocessing import get_all_start_methods, get_context
 from pathlib import Path
-from typing import Any, Iterable
+from typing import TYPE_CHECKING, Any, Callable, Iterable
 
 from ctmrpim.cases import load_case
 from ctmrpim.errors import ProblemError
-from ctmrpim.io.atomic import atomic_write_text
+from ctmrpim.io.atomic import atomic_write, atomic_write_text
 from ctmrpim.io.provenance import code_version, source_hash
 from ctmrpim.io.summary import to_jsonable, write_summary
 from ctmrpim.methods import solve
+
+if TYPE_CHECKING:
+    from ctmrpim.problem.case import Case
 
 
 @dataclass(frozen=True)
@@ -72,11 +89,17 @@ def method_version(name: str) -> str:
 def case_hash(spec: CaseSpec) -> str:
     """sha256 of the resolved input, the method and element, and the version of the code that computes
     them (this package's and the method's: never the sweep's, the studies' or the report's)."""
+    return resolve_case(spec)[1]
+
+
+def resolve_case(spec: CaseSpec) -> tuple[Case, str]:
+    """The :class:`Case` of ``spec`` and its hash (:func:`case_hash`), loaded once for both: the client sends
+    this Case to the worker, so the worker computes what was hashed even where its benchmark files differ."""
     case = load_case(spec.target, list(spec.overrides))
     payload = {"resolved": case.resolved, "solver": spec.solver, "element": spec.element,
                "version": method_version(spec.solver)}
     text = json.dumps(to_jsonable(payload), sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()
+    return case, hashlib.sha256(text.encode()).hexdigest()
 
 
 _warm = False
@@ -101,46 +124,84 @@ def _worker_setup() -> None:
     rpim.THREADS = 1
 
 
-def run_case(spec: CaseSpec, folder: str, key: str, worker: bool = True) -> dict[str, Any]:
-    """Solve one case and write its folder; returns the status record (never raises for a bad case).
+@dataclass
+class CaseRun:
+    """What running one case hands back to the client: its status record (``hash``, ``spec``, ``start``,
+    ``end``, ``status``, ``error``) and, when it ran in a scratch folder (a Dask worker), the files it wrote
+    there (path relative to the case folder -> contents); empty when it wrote the case folder in place."""
+    status: dict[str, Any]
+    files: dict[str, bytes] = field(default_factory=dict)
 
-    BLAS runs on one thread in every mode, so that a case gives the same bits in-process, in a local
-    worker and on a Dask worker (the RPIM thread count does not change any result).
+
+def run_case(spec: CaseSpec, case: Case, key: str, version: str, folder: str | None = None,
+             worker: bool = True) -> CaseRun:
+    """Solve ``case`` (the resolved input of ``spec``, hash ``key``) computed by code of ``version``; never
+    raises for a bad case.
+
+    In ``folder`` when given (a local run: the files are written in place, and an explicit run resumes
+    from a checkpoint there); otherwise in a scratch folder whose files come back in the :class:`CaseRun`,
+    since a remote worker's file system is not the client's. The status record is the caller's to write.
+    A worker whose code version is not ``version`` refuses the case (status ``failed``): its result would
+    be cached under a hash that does not describe it. BLAS runs on one thread in every mode, so that a case
+    gives the same bits in-process, in a local worker and on a Dask worker (the RPIM thread count does not
+    change any result).
     """
+    status: dict[str, Any] = {"hash": key, "spec": asdict(spec), "start": time.time()}
+    mine = method_version(spec.solver)
+    if mine != version:
+        status.update(status="failed", end=time.time(),
+                      error=f"worker {socket.gethostname()} has code version {mine} but the client {version}: "
+                            "install the client's code on the workers")
+        return CaseRun(status)
+    if folder is not None:
+        return CaseRun(_solve_into(spec, case, Path(folder), status, worker))
+    scratch = Path(tempfile.mkdtemp(prefix=f"ctmrpim-case-{key[:16]}-"))
+    try:
+        status = _solve_into(spec, case, scratch, status, worker)
+        files = {p.relative_to(scratch).as_posix(): p.read_bytes() for p in sorted(scratch.rglob("*")) if p.is_file()}
+        return CaseRun(status, files)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+def _solve_into(spec: CaseSpec, case: Case, folder: Path, status: dict[str, Any], worker: bool) -> dict[str, Any]:
+    """Solve ``case`` with ``spec``'s method into ``folder`` (``summary.json``, an explicit run's series and
+    checkpoints); ``status`` completed with the outcome."""
     from threadpoolctl import threadpool_limits
 
     if worker:
         _worker_setup()
     with threadpool_limits(1):
         _warm_up()
-    folder_path = Path(folder)
-    status: dict[str, Any] = {"hash": key, "spec": asdict(spec), "start": time.time()}
     try:
-        case = load_case(spec.target, list(spec.overrides))
         with threadpool_limits(1):
-            result = solve(case, spec.solver, spec.element, out=folder_path,   # explicit runs: series, checkpoints
-                           resume=(folder_path / "checkpoint.npz").is_file())
-        write_summary(result, folder_path, case.source)
+            result = solve(case, spec.solver, spec.element, out=folder,   # explicit runs: series, checkpoints
+                           resume=(folder / "checkpoint.npz").is_file())
+        write_summary(result, folder, case.source)
         status.update(status="ok")
     except ProblemError as exc:
         status.update(status="error", error=exc.message)
     except Exception as exc:  # a bug, recorded with its traceback so the sweep goes on
         status.update(status="error", error=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
     status["end"] = time.time()
-    atomic_write_text(folder_path / "status.json", json.dumps(to_jsonable(status), indent=1) + "\n")
     return status
 
 
 @dataclass
 class CaseOutcome:
-    """One case of a sweep after it ran (or was found in the cache): its folder, status (``ok`` or ``error``),
-    its ``summary.json`` as a dict (None unless ok) and the error message."""
+    """One case of a sweep after it ran (or was found in the cache): its folder, status (``ok``, ``error``
+    or ``failed``, see the module docstring), its ``summary.json`` as a dict (None unless ok) and the error
+    message."""
     spec: CaseSpec
     folder: Path
     status: str
     summary: dict[str, Any] | None
     error: str | None = None
     cached: bool = False
+
+
+#: a job for a worker: the spec, its resolved case and its hash
+Job = tuple[CaseSpec, "Case", str]
 
 
 class Sweep:
@@ -174,50 +235,79 @@ class Sweep:
 
     def run(self, specs: Iterable[CaseSpec], desc: str = "sweep") -> list[CaseOutcome]:
         """Run the cases of ``specs`` not done yet (each distinct hash once; ``desc`` labels the progress bar) and
-        return the outcomes of all of them, in the order of ``specs``."""
+        return the outcomes of all of them, in the order of ``specs``; a ProblemError once every case ran if some
+        could not run where they were sent (status ``failed``)."""
         specs = list(specs)
-        keys = [case_hash(s) for s in specs]
-        todo = [i for i, k in enumerate(keys) if self._done(k) is None]
-        unique: dict[str, int] = {}
-        for i in todo:
-            unique.setdefault(keys[i], i)
-        self.computed = len(unique)
-        if unique:
-            self._execute([(specs[i], str(self.folder(k)), k) for k, i in unique.items()], desc)
+        resolved = [resolve_case(s) for s in specs]
+        keys = [k for _, k in resolved]
+        statuses = {k: self._done(k) for k in dict.fromkeys(keys)}
+        jobs = {k: (specs[i], resolved[i][0], k) for i, k in enumerate(keys) if statuses[k] is None}
+        self.computed = len(jobs)
+        if jobs:
+            statuses.update(self._execute(list(jobs.values()), desc))
         out = []
         for spec, key in zip(specs, keys):
-            status = self._done(key) or {"status": "error", "error": "no status record was written"}
+            status = statuses[key]
             folder = self.folder(key)
             summary = json.loads((folder / "summary.json").read_text()) if status["status"] == "ok" else None
             out.append(CaseOutcome(spec=spec, folder=folder, status=status["status"], summary=summary,
-                                   error=status.get("error"), cached=key not in unique))
+                                   error=status.get("error"), cached=key not in jobs))
+        failed = [o for o in out if o.status == "failed"]
+        if failed:
+            raise ProblemError(f"{len(failed)} of {len(out)} cases could not run ({failed[0].error}); "
+                               "run again once that is fixed (finished cases are cached)")
         return out
 
-    def _execute(self, jobs: list[tuple[CaseSpec, str, str]], desc: str) -> None:
+    def store(self, key: str, run: CaseRun) -> dict[str, Any]:
+        """Write what ``run`` brought back into the case folder of ``key``, the status record last (so that the
+        case counts as done only once its files are all there); the status record."""
+        folder = self.folder(key)
+        for name, data in run.files.items():
+            atomic_write(folder / name, lambda p, data=data: p.write_bytes(data))
+        atomic_write_text(folder / "status.json", json.dumps(to_jsonable(run.status), indent=1) + "\n")
+        return run.status
+
+    def _execute(self, jobs: list[Job], desc: str) -> dict[str, dict[str, Any]]:
+        """Run ``jobs`` and store each as it finishes; hash -> status record."""
         from tqdm import tqdm
 
-        for _, folder, _ in jobs:
-            Path(folder).mkdir(parents=True, exist_ok=True)
+        statuses: dict[str, dict[str, Any]] = {}
         bar = tqdm(total=len(jobs), desc=desc, unit="case", disable=not self.progress, leave=False)
+
+        def finish(job: Job, run: Callable[[], CaseRun]) -> None:
+            try:
+                outcome = run()
+            except Exception as exc:  # the worker itself failed (died, could not load our code): not the case's fault
+                outcome = CaseRun({"hash": job[2], "spec": asdict(job[0]), "status": "failed",
+                                   "error": f"the worker failed: {type(exc).__name__}: {exc}"})
+            statuses[job[2]] = self.store(job[2], outcome)
+            bar.update()
+
         try:
             if self.scheduler:
-                self._execute_dask(jobs, bar)
-            elif self.workers == 1:
+                self._execute_dask(jobs, finish)
+                return statuses
+            for job in jobs:
+                self.folder(job[2]).mkdir(parents=True, exist_ok=True)
+            if self.workers == 1:
                 for job in jobs:
-                    run_case(*job, worker=False)
-                    bar.update()
+                    finish(job, lambda job=job: run_case(*job, method_version(job[0].solver),
+                                                        str(self.folder(job[2])), worker=False))
             else:
                 # fork needs no `if __name__ == "__main__"` guard in the caller's script; the parent holds
                 # no threads of ours between cases (RPIM's pool lives only inside one call)
                 ctx = get_context("fork" if "fork" in get_all_start_methods() else "spawn")
                 with ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_worker_setup) as pool:
-                    for fut in as_completed([pool.submit(run_case, *job) for job in jobs]):
-                        fut.result()
-                        bar.update()
+                    futures = {pool.submit(run_case, *job, method_version(job[0].solver), str(self.folder(job[2]))): job
+                               for job in jobs}
+                    for fut in as_completed(futures):
+                        finish(futures[fut], fut.result)
         finally:
             bar.close()
+        return statuses
 
-    def _execute_dask(self, jobs: list[tuple[CaseSpec, str, str]], bar) -> None:
+    def _execute_dask(self, jobs: list[Job], finish: Callable[[Job, Callable[[], CaseRun]], None]) -> None:
+        """Run ``jobs`` on the Dask scheduler; each result, files included, comes back to ``finish``."""
         try:
             from dask.distributed import Client
             from dask.distributed import as_completed as dask_completed
@@ -228,9 +318,9 @@ class Sweep:
         except OSError as exc:
             raise ProblemError(f"cannot reach the Dask scheduler at {self.scheduler!r} ({exc})") from None
         try:
-            futures = [client.submit(run_case, *job, pure=False) for job in jobs]
+            futures = {client.submit(run_case, *job, method_version(job[0].solver), pure=False): job for job in jobs}
             for fut in dask_completed(futures):
-                fut.result()
-                bar.update()
+                finish(futures[fut], fut.result)
+                fut.release()    # the worker may drop the files now that the client holds them
         finally:
             client.close()
