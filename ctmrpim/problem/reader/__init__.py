@@ -14,7 +14,7 @@ from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.model import Problem
 from ctmrpim.problem.reader.boundary import read_body_force, read_boundary
-from ctmrpim.problem.reader.effects import check_effects
+from ctmrpim.problem.reader.effects import check_effects, check_method_effects
 from ctmrpim.problem.reader.geometry import read_geometry
 from ctmrpim.problem.reader.keys import check_keys
 from ctmrpim.problem.reader.material import read_material
@@ -84,6 +84,7 @@ def parse_case(raw: dict, source: str, base_dir: Path, overrides: list[str] | No
                       point_loads=boundary.point_loads, walls=walls, body_load=body_load)
     nodes = read_nodes(values)
     method = read_method(values, model, analysis)
+    check_method_effects(raw, analysis, model, method)
     return Case(problem=problem, nodes=nodes, method=method, source=source, base_dir=base_dir,
                 resolved=resolve(raw, problem, nodes, method, solving), defaults=values.defaults,
                 loading=solving.loading, strength_reduction=solving.strength_reduction,

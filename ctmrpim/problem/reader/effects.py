@@ -12,6 +12,7 @@ import warnings
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.reader.problem_table import ProblemTable
+from ctmrpim.problem.settings import Method
 
 #: [material] keys only the Mohr-Coulomb model reads
 MOHR_COULOMB_KEYS = ("c", "phi", "psi", "tension")
@@ -57,3 +58,20 @@ def check_effects(raw: dict, table: ProblemTable, model: str, density: float) ->
                 missing = [k for k in group if k not in exact]
                 raise ProblemError(f"{' and '.join(missing)} missing: {what} is compared only when "
                                    f"{', '.join(group[:-1])} and {group[-1]} are all given", key="exact")
+
+
+def check_method_effects(raw: dict, analysis: str, model: str, method: Method) -> None:
+    """Raise for a ``[method]`` key given in ``raw`` that the solver path of ``analysis`` and ``model`` does not
+    read (the path's own keys: large deformation, explicit dynamics, the consistent integration)."""
+    given = raw.get("method", {})
+    large_deformation = analysis == "quasi-static" and model != "mohr-coulomb"
+    readers = {
+        "formulation": (large_deformation, "a quasi-static analysis of a neo-Hookean or linear-elastic body"),
+        "point_regeneration": (large_deformation and method.formulation == "updated-lagrangian",
+                               "the updated-Lagrangian formulation"),
+        "min_support": (analysis == "explicit", "explicit dynamics"),
+        "correction": (method.integration == "ctm-vci", "integration = \"ctm-vci\""),
+    }
+    for key, (read, by) in readers.items():
+        if key in given and not read:
+            raise ProblemError(f"{key} is read only by {by}: it has no effect here, remove it", key=f"method.{key}")
