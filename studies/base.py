@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
+from ctmrpim.errors import ProblemError
 from ctmrpim.io.atomic import atomic_write, atomic_write_text
 from studies.sweep import CaseOutcome, CaseSpec, Sweep
 
@@ -73,6 +74,10 @@ def run_study(module: ModuleType, quick: bool = True, out_dir: Path = Path("repo
     for _, r in failed.iterrows():
         progress(f"  case failed: {r.to_dict()}")
     progress(f"  {len(specs) - sweep.computed} cached, {sweep.computed} computed, {len(failed)} failed")
+    if len(failed) == len(df):   # nothing to tabulate or plot: say so instead of an empty figure's traceback
+        first = failed.iloc[0].to_dict() if len(failed) else {}
+        raise ProblemError(f"study {module.NAME}: all {len(df)} cases failed (first: status {first.get('status')!r}"
+                           f"{', ' + str(first['error_message']) if first.get('error_message') else ''}); nothing written")
     out_dir = Path(out_dir)
     atomic_write_text(out_dir / f"{module.NAME}.csv", df.to_csv(index=False))
     fig = module.figure(df)
