@@ -18,7 +18,9 @@ class Result:
     points: np.ndarray                # (n, 2) field nodes / mesh vertices
     u: np.ndarray                     # (n, 2) displacement at the points
     stress: np.ndarray                # (n, 3) sxx, syy, sxy at the points
-    cells: list[tuple[str, np.ndarray]] = field(default_factory=list)  # meshio cell blocks (boundary lines, elements)
+    # meshio cell blocks on the points: CTM-RPIM the tracked boundary ("line") then the body's triangles inside it
+    # ("triangle", the alpha shape's); finite elements their elements ("triangle" or "quad")
+    cells: list[tuple[str, np.ndarray]] = field(default_factory=list)
     probes: dict[str, dict[str, float]] = field(default_factory=dict)
     errors: dict[str, Any] = field(default_factory=dict)
     counts: dict[str, Any] = field(default_factory=dict)
@@ -26,9 +28,20 @@ class Result:
     parameters: dict[str, Any] = field(default_factory=dict)   # fully resolved input and derived values
     defaults: list[str] = field(default_factory=list)          # defaults that were applied
     history: list[dict[str, Any]] = field(default_factory=list)  # one entry per load increment
-    series: list[dict[str, Any]] = field(default_factory=list)   # per converged increment: load_factor, u, stress
+    # per converged increment: load_factor (or time), u, stress, stress_zz; where the solver re-tracks, also the
+    # tracked "boundary" (e, 2) and its "triangles" (t, 3) on that increment's configuration
+    series: list[dict[str, Any]] = field(default_factory=list)
     fields: dict[str, np.ndarray] = field(default_factory=dict)  # further nodal fields (plastic strain ...)
     outcome: dict[str, Any] = field(default_factory=dict)        # headline results (factor_of_safety ...)
+    stress_zz: np.ndarray | None = None   # (n,) out-of-plane stress szz at the points; None: zero (plane stress)
+
+
+def out_of_plane_stress(problem: Problem, stress: np.ndarray) -> np.ndarray:
+    """(n,) szz of a linear-elastic in-plane stress ``stress`` (n, 3: sxx, syy, sxy): nu (sxx + syy) in plane
+    strain (ezz = 0), zero in plane stress."""
+    if problem.plane == "strain":
+        return problem.material.nu * (stress[:, 0] + stress[:, 1])
+    return np.zeros(len(stress))
 
 
 def probe_record(x: float, y: float, u: np.ndarray, s: np.ndarray) -> dict[str, float]:

@@ -116,7 +116,7 @@ def solve_fem_elastoplastic(case: Case, element: str = "p2",
     material = problem.material
     out = PlasticOutput(
         method=f"fem-{element}-mc", points=mesh.p.T.copy(), cells=[(fm.cell_type, fm.cells)],
-        displacement=lambda U: U[basis.nodal_dofs].T.copy(), nodal=vertex_average,
+        displacement=lambda U: U[basis.nodal_dofs].T.copy(), nodal=vertex_average, average=vertex_average,
         probe_values=probe_values, peak_traction=_peak_traction(problem, fm, vec, tol),
         counts={"nodes": int(mesh.nvertices), "dofs": int(basis.N), "elements": int(mesh.nelements),
                 "integration_points": len(w)},

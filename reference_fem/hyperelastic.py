@@ -173,12 +173,19 @@ def _stress_tangent(material: NeoHookean, basis: Basis, U: np.ndarray) -> tuple[
 
 
 def _cauchy(material: NeoHookean, basis: Basis, U: np.ndarray) -> np.ndarray:
-    """(3, nel, nq) Cauchy stress sxx, syy, sxy = P F^T / J at the quadrature points of ``basis``."""
+    """(4, nel, nq) Cauchy stress sxx, syy, sxy = P F^T / J and szz = lambda ln J / J (plane strain, F33 = 1)
+    at the quadrature points of ``basis``."""
     F = _deformation_gradients(basis, U)
     P, _ = material.stress_tangent(F)
-    sig = P @ F.transpose(0, 2, 1) / np.linalg.det(F)[:, None, None]
+    J = np.linalg.det(F)
+    sig = P @ F.transpose(0, 2, 1) / J[:, None, None]
     nel, nq = basis.nelems, basis.X.shape[-1]
-    return np.stack([sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1]]).reshape(3, nel, nq)
+    return np.stack([sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1], material.lam * np.log(J) / J]).reshape(4, nel, nq)
+
+
+def _split(stress: np.ndarray) -> dict[str, np.ndarray]:
+    """``stress`` (n, 3) and ``stress_zz`` (n,) of nodal stresses (n, 4: sxx, syy, sxy, szz)."""
+    return {"stress": stress[:, :3], "stress_zz": stress[:, 3]}
 
 
 def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> Result:
@@ -221,7 +228,7 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
     mass = splu(csc_matrix(BilinearForm(lambda u, v, w: u * v).assemble(scalar)))
 
     def nodal_stress(U: np.ndarray) -> np.ndarray:
-        """(scalar.N, 3) L2 projection of the Cauchy stress."""
+        """(scalar.N, 4) L2 projection of the Cauchy stress (sxx, syy, sxy, szz)."""
         s = _cauchy(material, pbasis, U)
         rhs = np.column_stack([LinearForm(lambda v, w: w.s * v).assemble(scalar, s=c) for c in s])
         return mass.solve(rhs)
@@ -249,7 +256,7 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
 
     def on_converged(factor: float, U: np.ndarray) -> dict:
         series.append({"load_factor": factor, "u": U[basis.nodal_dofs].T.copy(),
-                       "stress": nodal_stress(U)[scalar.nodal_dofs[0]]})
+                       **_split(nodal_stress(U)[scalar.nodal_dofs[0]])})
         out = {}
         for p, Pu in zip(problem.probes, probe_u):
             up = (Pu @ U).ravel()
@@ -263,12 +270,12 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
     stress_dofs = nodal_stress(U)
     probes = {}
     for p, at, Pu in zip(problem.probes, probe_at, probe_u):
-        probes[p.name] = probe_record(p.x, p.y, (Pu @ U).ravel(), (scalar.probes(at) @ stress_dofs)[0])
+        probes[p.name] = probe_record(p.x, p.y, (Pu @ U).ravel(), (scalar.probes(at) @ stress_dofs)[0, :3])
     timer.lap("postprocess")
 
     return Result(
         method=f"fem-{element}-tl", points=mesh.p.T.copy(), u=U[basis.nodal_dofs].T.copy(),
-        stress=stress_dofs[scalar.nodal_dofs[0]], cells=[(fm.cell_type, fm.cells)], probes=probes, errors={},
+        **_split(stress_dofs[scalar.nodal_dofs[0]]), cells=[(fm.cell_type, fm.cells)], probes=probes, errors={},
         counts={"nodes": int(mesh.nvertices), "dofs": int(basis.N), "elements": int(mesh.nelements),
                 "integration_points": int(np.asarray(basis.dx).size),
                 "load_increments": sum(h["converged"] for h in history), "newton_iterations": path.newton_iterations,

@@ -25,7 +25,7 @@ from skfem.assembly.basis import AbstractBasis
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
 from ctmrpim.reference.error_norms import relative_errors
-from ctmrpim.result import Result, probe_errors, probe_record
+from ctmrpim.result import Result, out_of_plane_stress, probe_errors, probe_record
 from ctmrpim.timing import Timer
 from reference_fem.boundary_conditions import constrained_dofs, load_vector, locate
 from reference_fem.mesh import build_mesh
@@ -97,6 +97,7 @@ def solve_fem(case: Case, element: str = "q1") -> Result:
 
     return Result(
         method=f"fem-{element}", points=points, u=u_nodes, stress=stress_nodes,
+        stress_zz=out_of_plane_stress(problem, stress_nodes),
         cells=[(fm.cell_type, fm.cells)], probes=probes, errors=errors,
         counts={"nodes": int(mesh.nvertices), "dofs": int(basis.N), "elements": int(mesh.nelements),
                 "integration_points": int(np.asarray(basis.dx).size)},

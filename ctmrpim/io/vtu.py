@@ -1,9 +1,15 @@
 """VTU files (meshio) of a result, ParaView ``.pvd`` series of its increments or time steps.
 
-``result.vtu``: field nodes (or mesh vertices) as vertex cells with point data ``u`` and ``stress``,
-the tracked boundary (or the elements) as further cells. A series is one VTU per saved state with a
-``.pvd`` index (meshio has no PVD writer; XDMF time series keep the topology fixed, and a cloud's
-boundary changes from step to step). Every file is written atomically.
+``result.vtu``: the field nodes (or mesh vertices) as ``vertex`` cells, the tracked boundary as ``line`` cells
+and the body as surface cells (CTM-RPIM: the alpha shape's triangles, which fill the tracked loops exactly,
+corners included; finite elements: their own triangles or quads), so that ParaView shows a surface coloured
+by any field. Point data: ``u`` (n, 3), ``stress`` (n, 6), the symmetric tensor in ParaView's component
+order xx, yy, zz, xy, yz, xz (ParaView recognises six components as a symmetric tensor; zz is the
+out-of-plane stress, yz = xz = 0), the same components as named scalars ``stress_xx``, ``stress_yy``,
+``stress_zz``, ``stress_xy`` (meshio writes no component names), ``von_mises``, and the solver's further
+fields. A series is one VTU per saved state with a ``.pvd`` index (meshio has no PVD writer; XDMF time
+series keep the topology fixed, and a cloud's boundary changes from step to step). Every file is written
+atomically.
 """
 from __future__ import annotations
 
@@ -15,29 +21,63 @@ import numpy as np
 from ctmrpim.io.atomic import atomic_write, atomic_write_text
 from ctmrpim.result import Result
 
+#: ParaView's order of the six components of a symmetric tensor, and of ours
+TENSOR_COMPONENTS = ("xx", "yy", "zz", "xy", "yz", "xz")
 
-def _mesh(result: Result, u: np.ndarray, stress: np.ndarray, moved: bool,
-          boundary: np.ndarray | None = None, fields: dict[str, np.ndarray] | None = None) -> meshio.Mesh:
-    n = len(result.points)
-    xy = result.points + u if moved else result.points
-    blocks = result.cells if boundary is None else [("line", boundary)]
-    cells = [("vertex", np.arange(n).reshape(-1, 1))] + [(k, np.asarray(v)) for k, v in blocks]
-    return meshio.Mesh(np.c_[xy, np.zeros(n)], cells,
-                       point_data={"u": np.c_[u, np.zeros(n)], "stress": stress, **(fields or {})})
+
+def stress_point_data(stress: np.ndarray, stress_zz: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Point data of the in-plane stress ``stress`` (n, 3: sxx, syy, sxy) and the out-of-plane ``stress_zz`` (n,)
+    (None: zero, plane stress): ``stress`` (n, 6) in :data:`TENSOR_COMPONENTS` order, the named components
+    ``stress_xx``, ``stress_yy``, ``stress_zz``, ``stress_xy`` (n,) and ``von_mises`` (n,)."""
+    stress = np.asarray(stress, float)
+    n = len(stress)
+    sxx, syy, sxy = stress[:, 0], stress[:, 1], stress[:, 2]
+    szz = np.zeros(n) if stress_zz is None else np.asarray(stress_zz, float).reshape(n)
+    zero = np.zeros(n)
+    mises = np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2) + 3.0 * sxy ** 2)
+    return {"stress": np.c_[sxx, syy, szz, sxy, zero, zero], "stress_xx": sxx.copy(), "stress_yy": syy.copy(),
+            "stress_zz": szz.copy(), "stress_xy": sxy.copy(), "von_mises": mises}
+
+
+def in_plane_stress(point_data: dict[str, np.ndarray]) -> np.ndarray:
+    """(n, 3) sxx, syy, sxy of point data written by :func:`stress_point_data` (read back from a VTU)."""
+    s = np.asarray(point_data["stress"])
+    return s[:, [0, 1, 3]]
+
+
+def _mesh(points: np.ndarray, u: np.ndarray, stress: np.ndarray, stress_zz: np.ndarray | None,
+          cells: list[tuple[str, np.ndarray]], fields: dict[str, np.ndarray] | None = None) -> meshio.Mesh:
+    n = len(points)
+    blocks = [("vertex", np.arange(n).reshape(-1, 1))] + [(k, np.asarray(v)) for k, v in cells if len(v)]
+    return meshio.Mesh(np.c_[points, np.zeros(n)], blocks,
+                       point_data={"u": np.c_[u, np.zeros(n)], **stress_point_data(stress, stress_zz),
+                                   **(fields or {})})
+
+
+def _step_cells(result: Result, step: dict) -> list[tuple[str, np.ndarray]]:
+    """The cells of a series step: its own tracked boundary and triangles where the solver re-tracked, else
+    the result's (the reference ones, moved with the nodes)."""
+    if step.get("boundary") is None:
+        return result.cells
+    cells = [("line", step["boundary"])]
+    if step.get("triangles") is not None:
+        cells.append(("triangle", step["triangles"]))
+    return cells
 
 
 def write_vtu(result: Result, out_dir: Path) -> Path:
-    """Field nodes as vertex cells with point data u and stress; boundary / elements as further cells
-    (reference configuration: warp by u in ParaView to see the deformed body)."""
+    """``result.vtu``: the points as vertex cells with ``result.cells`` (boundary lines, surface triangles or
+    elements) and the point data of the module docstring, on the reference configuration (warp by u in
+    ParaView to see the deformed body)."""
     path = Path(out_dir) / "result.vtu"
-    mesh = _mesh(result, result.u, result.stress, moved=False, fields=result.fields)
+    mesh = _mesh(result.points, result.u, result.stress, result.stress_zz, result.cells, result.fields)
     atomic_write(path, lambda p: meshio.write(p, mesh, file_format="vtu"))
     return path
 
 
 def write_series(result: Result, out_dir: Path) -> list[Path]:
     """One VTU per converged load increment on the *current* configuration (nodes moved by u, with
-    the boundary tracked on it where the solver re-tracks, else the reference one moved), and
+    the boundary and triangles tracked on it where the solver re-tracks, else the reference ones moved), and
     ``result.pvd``, the index ParaView opens as a time series (docs/design.md, 'Output'). The index is
     written last, so a series is only announced once all its files exist."""
     if not result.series:
@@ -47,8 +87,8 @@ def write_series(result: Result, out_dir: Path) -> list[Path]:
     written = []
     for k, step in enumerate(result.series, start=1):
         name = f"series/step_{k:04d}.vtu"
-        mesh = _mesh(result, step["u"], step["stress"], moved=True, boundary=step.get("boundary"),
-                     fields=step.get("fields"))
+        mesh = _mesh(result.points + step["u"], step["u"], step["stress"], step.get("stress_zz"),
+                     _step_cells(result, step), step.get("fields"))
         atomic_write(out_dir / name, lambda p, m=mesh: meshio.write(p, m, file_format="vtu"))
         written.append(out_dir / name)
         entries.append((step["time"] if "time" in step else step["load_factor"], name))  # strength reduction: SRF
@@ -82,11 +122,12 @@ class SeriesWriter:
     def add(self, time: float, points: np.ndarray, cells: list[tuple[str, np.ndarray]],
             point_data: dict[str, np.ndarray]) -> Path:
         """Write the state at ``time``: nodes ``points`` (n, 2) as vertex cells, further ``cells`` (type,
-        connectivity), ``point_data`` arrays (n, ...) by name; then rewrite the index. The new file's path."""
+        connectivity: the boundary lines and surface triangles), ``point_data`` arrays (n, ...) by name (the
+        stress as :func:`stress_point_data` lays it out); then rewrite the index. The new file's path."""
         n = len(points)
         name = f"series/step_{len(self.entries):05d}.vtu"
-        mesh = meshio.Mesh(np.c_[points, np.zeros(n)], [("vertex", np.arange(n).reshape(-1, 1)), *cells],
-                           point_data=point_data)
+        blocks = [("vertex", np.arange(n).reshape(-1, 1))] + [(k, np.asarray(v)) for k, v in cells if len(v)]
+        mesh = meshio.Mesh(np.c_[points, np.zeros(n)], blocks, point_data=point_data)
         atomic_write(self.out_dir / name, lambda p: meshio.write(p, mesh, file_format="vtu"))
         self.entries.append((float(time), name))
         atomic_write_text(self.out_dir / "result.pvd", pvd_text(self.entries))

@@ -14,6 +14,7 @@ import numpy as np
 from ctmrpim.discretisation import assembly
 from ctmrpim.discretisation.boundary_loads import reference_loads
 from ctmrpim.discretisation.configuration import BoundaryTags, Configuration, boundary_tags, reference_configuration
+from ctmrpim.discretisation.nodal_average import RADIUS, KernelAverage
 from ctmrpim.discretisation.state_transfer import NodalProjection
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
@@ -53,6 +54,7 @@ def solve_elastoplastic(case: Case, progress: Callable[[Any], None] = lambda lev
     timer.lap("assembly")
 
     nodal = NodalProjection(sf.N, system.w)
+    average = KernelAverage(nodes, conf.points, system.w, RADIUS * conf.lengths.d_c)
 
     def probe_values(U: np.ndarray, stress: np.ndarray | None) -> dict:
         if sf_p is None:
@@ -64,8 +66,9 @@ def solve_elastoplastic(case: Case, progress: Callable[[Any], None] = lambda lev
     sizes = sf.support_sizes
     material = problem.material
     out = PlasticOutput(
-        method="ctm-rpim-mc", points=nodes, cells=[("line", conf.boundary.edges)],
-        displacement=lambda U: U.reshape(-1, 2).copy(), nodal=nodal, probe_values=probe_values,
+        method="ctm-rpim-mc", points=nodes,
+        cells=[("line", conf.boundary.edges), ("triangle", conf.boundary.triangles)],
+        displacement=lambda U: U.reshape(-1, 2).copy(), nodal=nodal, average=average, probe_values=probe_values,
         peak_traction=float(np.hypot(tags.tx, tags.ty).max(initial=0.0)),
         counts={"nodes": len(nodes), "integration_points": len(system.w),
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},

@@ -17,7 +17,7 @@ from ctmrpim.discretisation.stress_recovery import recovered_stress
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
 from ctmrpim.reference.error_norms import relative_errors
-from ctmrpim.result import Result, probe_errors, probe_record
+from ctmrpim.result import Result, out_of_plane_stress, probe_errors, probe_record
 from ctmrpim.solvers.linear_solver import solve_constrained
 from ctmrpim.timing import Timer
 
@@ -94,8 +94,8 @@ def solve_ctmrpim(case: Case) -> Result:
 
     sizes = sf.support_sizes
     return Result(
-        method="ctm-rpim", points=nodes, u=u, stress=stress,
-        cells=[("line", boundary.edges)],
+        method="ctm-rpim", points=nodes, u=u, stress=stress, stress_zz=out_of_plane_stress(problem, stress),
+        cells=[("line", boundary.edges), ("triangle", boundary.triangles)],
         probes=probes, errors=errors,
         counts={"nodes": len(nodes), "integration_points": len(quad.weights), "integration_lines": quad.n_lines,
                 "traction_points": len(traction_q.weights), "boundary_loops": len(boundary.loops),

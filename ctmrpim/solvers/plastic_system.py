@@ -234,14 +234,22 @@ class PlasticOutput:
     cells: list
     displacement: Callable[[np.ndarray], np.ndarray]            # U -> (n, 2) at the points
     nodal: Callable[[np.ndarray], np.ndarray]                   # (m, k) at the integration points -> (n, k)
+    average: Callable[[np.ndarray], np.ndarray]                 # the same, a non-negative weighted mean of them
     probe_values: Callable[[np.ndarray, np.ndarray], dict]      # (U, stress (m, 3)) -> {name: probe record}
     peak_traction: float                                        # largest traction magnitude at full load
     counts: dict[str, Any]
     parameters: dict[str, Any]
 
     def plastic_field(self, plastic_strain: np.ndarray) -> dict[str, np.ndarray]:
-        """Point data ``plastic_strain``: the equivalent plastic strain of (m, 4) point values, at the points."""
-        return {"plastic_strain": self.nodal(equivalent_plastic_strain(plastic_strain)[:, None])[:, 0]}
+        """Point data ``plastic_strain``: the equivalent plastic strain of (m, 4) point values, at the points,
+        by ``average``: a projection that can overshoot would show negative plastic strain beside a shear band."""
+        return {"plastic_strain": self.average(equivalent_plastic_strain(plastic_strain)[:, None])[:, 0]}
+
+    def nodal_stress(self, stress: np.ndarray) -> dict[str, np.ndarray]:
+        """``stress`` (n, 3: sxx, syy, sxy) and ``stress_zz`` (n,) at the points of the (m, 4: xx, yy, xy, zz)
+        stresses at the integration points."""
+        nodal = self.nodal(stress)
+        return {"stress": nodal[:, :3], "stress_zz": nodal[:, 3]}
 
 
 def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, timer: Timer,
@@ -253,7 +261,7 @@ def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, tim
     series: list[dict] = []
 
     def on_converged(factor: float, U: np.ndarray) -> dict:
-        series.append({"load_factor": factor, "u": out.displacement(U), "stress": out.nodal(system.stress[:, :3]),
+        series.append({"load_factor": factor, "u": out.displacement(U), **out.nodal_stress(system.stress),
                        "fields": out.plastic_field(system.plastic_strain)})
         record = {"plastic_points": int((system.region != ELASTIC).sum())}
         for name, rec in out.probe_values(U, None).items():
@@ -273,14 +281,14 @@ def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, tim
                       stop_on_failure=case.loading.until_failure)
     timer.lap("solve")
     probes = out.probe_values(path.U, system.stress[:, :3])
-    stress = out.nodal(system.stress[:, :3])
+    stress = out.nodal_stress(system.stress)
     fields = out.plastic_field(system.plastic_strain)
     timer.lap("postprocess")
     counts = {**out.counts, "load_increments": sum(h["converged"] for h in path.history),
               "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
               "plastic_points": int((system.region != ELASTIC).sum()), **system.iteration_counts()}
     return Result(
-        method=out.method, points=out.points, u=out.displacement(path.U), stress=stress, cells=out.cells,
+        method=out.method, points=out.points, u=out.displacement(path.U), **stress, cells=out.cells,
         probes=probes, errors={}, counts=counts, timings=timer.total(), history=path.history, series=series,
         outcome=limit_load(path, out.peak_traction) if case.loading.until_failure else {},
         fields=fields, parameters=out.parameters, defaults=case.defaults)
@@ -293,7 +301,8 @@ def _relaxed(case: Case, system: PlasticSystem, out: PlasticOutput, timer: Timer
     timer.lap("solve")
     stress = system.stress[:, :3]
     result = Result(
-        method=out.method, points=out.points, u=out.displacement(system.U), stress=out.nodal(stress), cells=out.cells,
+        method=out.method, points=out.points, u=out.displacement(system.U), **out.nodal_stress(system.stress),
+        cells=out.cells,
         probes=out.probe_values(system.U, stress), errors={},
         counts={**out.counts, "steps": path.steps, "plastic_points": int((system.region != ELASTIC).sum())},
         timings={}, history=path.history,

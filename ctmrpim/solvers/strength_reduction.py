@@ -222,13 +222,14 @@ def solve_strength_reduction(case: Case, system, out, base: Result,
     series = []
     for lv in levels:
         U, stress, _, plastic = lv.state
-        series.append({"time": lv.srf, "load_factor": 1.0, "u": out.displacement(U), "stress": out.nodal(stress[:, :3]),
+        series.append({"time": lv.srf, "load_factor": 1.0, "u": out.displacement(U), **out.nodal_stress(stress),
                        "fields": {**out.plastic_field(plastic), "stable": np.full(len(base.points), float(lv.stable))}})
     last = next((lv for lv in reversed(levels) if lv.stable and lv.srf == stable), None)
     if last is not None:
         U, stress, _, plastic = last.state
         base.u = out.displacement(U)
-        base.stress = out.nodal(stress[:, :3])
+        nodal = out.nodal_stress(stress)
+        base.stress, base.stress_zz = nodal["stress"], nodal["stress_zz"]
         base.probes = out.probe_values(U, stress[:, :3])
         base.fields = out.plastic_field(plastic)
     base.history = [lv.record() for lv in levels]

@@ -29,11 +29,13 @@ from ctmrpim.timing import Timer
 
 
 def _cauchy(material: NeoHookean, G: sp.csr_matrix, U: np.ndarray) -> np.ndarray:
-    """(m, 3) Cauchy stress sxx, syy, sxy = P F^T / J at the rows of G (stored on the reference points)."""
+    """(m, 4) Cauchy stress sxx, syy, sxy = P F^T / J and szz at the rows of G (stored on the reference points);
+    with F33 = 1, P33 = mu + (lambda ln J - mu) = lambda ln J, so szz = lambda ln J / J."""
     F = np.eye(2)[None] + (G @ U).reshape(-1, 2, 2)
     P, _ = material.stress_tangent(F)
-    sig = P @ F.transpose(0, 2, 1) / np.linalg.det(F)[:, None, None]
-    return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1]]
+    J = np.linalg.det(F)
+    sig = P @ F.transpose(0, 2, 1) / J[:, None, None]
+    return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1], material.lam * np.log(J) / J]
 
 
 def solve_total_lagrangian(case: Case) -> Result:
@@ -83,7 +85,8 @@ def solve_total_lagrangian(case: Case) -> Result:
 
     def on_converged(factor: float, U: np.ndarray) -> dict:
         u = U.reshape(-1, 2)
-        series.append({"load_factor": factor, "u": u.copy(), "stress": _cauchy(material, G_nodes, U)})
+        sig = _cauchy(material, G_nodes, U)
+        series.append({"load_factor": factor, "u": u.copy(), "stress": sig[:, :3], "stress_zz": sig[:, 3]})
         if sf_p is None:
             return {}
         up = sf_p.N @ u
@@ -95,17 +98,17 @@ def solve_total_lagrangian(case: Case) -> Result:
     timer.lap("solve")
 
     u = U.reshape(-1, 2)
-    stress = series[-1]["stress"] if series else _cauchy(material, G_nodes, U)
+    stress = np.c_[series[-1]["stress"], series[-1]["stress_zz"]] if series else _cauchy(material, G_nodes, U)
     probes = {}
     if sf_p is not None:
         up = sf_p.N @ u
         sig = _cauchy(material, gradient_operator(sf_p.dNdx, sf_p.dNdy), U)
-        probes = {p.name: probe_record(p.x, p.y, up[i], sig[i]) for i, p in enumerate(problem.probes)}
+        probes = {p.name: probe_record(p.x, p.y, up[i], sig[i, :3]) for i, p in enumerate(problem.probes)}
     timer.lap("postprocess")
     sizes = sf.support_sizes
     return Result(
-        method="ctm-rpim-tl", points=nodes, u=u, stress=stress,
-        cells=[("line", conf.boundary.edges)], probes=probes, errors={},
+        method="ctm-rpim-tl", points=nodes, u=u, stress=stress[:, :3], stress_zz=stress[:, 3],
+        cells=[("line", conf.boundary.edges), ("triangle", conf.boundary.triangles)], probes=probes, errors={},
         counts={"nodes": n, "integration_points": len(w), "load_increments": sum(h["converged"] for h in history),
                 "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())}},

@@ -301,6 +301,21 @@ class AdaptiveBody:
         """(n, 3) Cauchy stress sxx, syy, sxy at the nodes, of the state projected to them."""
         return self.update.cauchy(self.nodal_state)
 
+    def stress_zz_nodes(self) -> np.ndarray:
+        """(n,) out-of-plane Cauchy stress szz at the nodes: the rate law's state holds it; neo-Hookean (plane
+        strain, F33 = 1) has szz = lambda ln J / J with J = sqrt(det b)."""
+        state = self.nodal_state
+        if isinstance(self.update, HypoelasticUpdate):
+            return state[:, 3].copy()
+        J = np.sqrt(state[:, 0] * state[:, 1] - state[:, 2] ** 2)
+        return self.update.material.lam * np.log(J) / J
+
+    def step_output(self) -> dict[str, np.ndarray]:
+        """A series step's nodal output on the current configuration: ``u``, ``stress``, ``stress_zz``, the tracked
+        ``boundary`` edges and the ``triangles`` of the body inside them."""
+        return {"u": self.u, "stress": self.stress_nodes(), "stress_zz": self.stress_zz_nodes(),
+                "boundary": self.boundary.edges.copy(), "triangles": self.boundary.triangles.copy()}
+
 
 def _traction_tags(nodes: np.ndarray, tags: BoundaryTags, thickness: float) -> TractionTags:
     q = tags.traction
@@ -358,8 +373,7 @@ def solve_updated_lagrangian(case: Case) -> Result:
         # nothing is solved on the final configuration: no rebuild there (at the full end moment the
         # tip face touches the root face, where no alpha shape separates them)
         skipped = body.commit(U, rebuild=factor < 1.0 - 1e-12)
-        series.append({"load_factor": factor, "u": body.u.copy(), "stress": body.stress_nodes(),
-                       "boundary": body.boundary.edges.copy()})
+        series.append({"load_factor": factor, **body.step_output()})
         return {**probe_values(), "tracked_area": body.areas[-1], "boundary_loops": len(body.boundary.loops),
                 **({"note": skipped} if skipped else {})}
 
@@ -376,8 +390,8 @@ def solve_updated_lagrangian(case: Case) -> Result:
     sizes = body.sf.support_sizes
     areas = np.array(body.areas)
     return Result(
-        method="ctm-rpim-ul", points=X, u=body.u, stress=body.stress_nodes(),
-        cells=[("line", body.boundary.edges)], probes=probes, errors={},
+        method="ctm-rpim-ul", points=X, u=body.u, stress=body.stress_nodes(), stress_zz=body.stress_zz_nodes(),
+        cells=[("line", body.boundary.edges), ("triangle", body.boundary.triangles)], probes=probes, errors={},
         counts={"nodes": n, "integration_points": len(body.w), "load_increments": sum(h["converged"] for h in history),
                 "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
                 "rebuilds": body.rebuilds, "state_transfers": body.transfers,

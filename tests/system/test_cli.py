@@ -15,6 +15,7 @@ import pytest
 
 from ctmrpim import benchmarks, methods
 from ctmrpim.cli import main
+from ctmrpim.io.vtu import in_plane_stress
 from ctmrpim.result import Result
 from studies import tolerances
 
@@ -137,8 +138,8 @@ def test_vtu_round_trip(run, api) -> None:
     mesh = meshio.read(out / "result.vtu")
     np.testing.assert_array_equal(mesh.points[:, :2], api.points)
     assert np.all(mesh.points[:, 2] == 0.0)
-    u, stress = mesh.point_data["u"], mesh.point_data["stress"]
-    assert u.shape == (297, 3) and stress.shape == (297, 3) and np.all(u[:, 2] == 0.0)
+    u, stress = mesh.point_data["u"], in_plane_stress(mesh.point_data)   # the tensor's xx, yy, xy
+    assert u.shape == (297, 3) and mesh.point_data["stress"].shape == (297, 6) and np.all(u[:, 2] == 0.0)
     np.testing.assert_allclose(u[:, :2], api.u, rtol=1e-12, atol=1e-12 * np.abs(api.u).max())
     np.testing.assert_allclose(stress, api.stress, rtol=1e-12, atol=1e-12 * np.abs(api.stress).max())
     # the tip (48, 0) is a node; RPIM shape functions interpolate (Kronecker delta), so the nodal
@@ -153,7 +154,7 @@ def test_vtu_round_trip(run, api) -> None:
         assert stress[k, j] == pytest.approx(tip[name], abs=1e-9 * scale)
     # the tracked boundary as line cells: one closed loop round the 33 x 9 grid
     cells = mesh.cells_dict
-    assert set(cells) == {"vertex", "line"}
+    assert set(cells) == {"vertex", "line", "triangle"}   # the body's surface: 2 x 32 x 8 triangles
     assert np.array_equal(cells["vertex"].ravel(), np.arange(297))
     lines = cells["line"]
     assert lines.shape == (2 * (33 + 9) - 4, 2) == (s["counts"]["boundary_nodes"], 2)
@@ -176,7 +177,7 @@ def test_fem_q1(tmp_path: Path, run, in_process) -> None:
     ours = meshio.read(run[1] / "result.vtu")
     np.testing.assert_array_equal(mesh.points, ours.points)   # the same nodes as CTM-RPIM
     assert mesh.cells_dict["quad"].shape == (32 * 8, 4)
-    assert mesh.point_data["u"].shape == (297, 3) and mesh.point_data["stress"].shape == (297, 3)
+    assert mesh.point_data["u"].shape == (297, 3) and mesh.point_data["stress"].shape == (297, 6)
 
 
 def test_set_grid_quiet_and_default_folder(tmp_path: Path, in_process) -> None:

@@ -59,16 +59,18 @@ class FrameBuilder:
         free[detached] = True
         loops = [body[lp] for lp in sub.loops]
         quad, w = lay_points([x[lp] for lp in loops], self.lengths, self.thickness)
-        return self.frame_at(x, free, quad.points, w, loops)
+        return self.frame_at(x, free, quad.points, w, loops, body[sub.triangles])
 
     def frame_at(self, x: np.ndarray, free: np.ndarray, points: np.ndarray, w: np.ndarray,
-                 loops: list[np.ndarray]) -> Configuration:
+                 loops: list[np.ndarray], triangles: np.ndarray) -> Configuration:
         """RPIM of the body's nodes at positions x (n, 2) (``free`` (n,) marks the others) at ``points`` (m, 2)
-        with weights ``w`` (m,); ``loops`` the boundary (node indices). A point whose moment matrix is
-        singular, or whose shape-function gradients exceed GRADIENT_LIMIT / d_c (it extrapolates from a
-        support on one side, where the nodes around it have left the body), gets weight 0: it integrates
-        nothing (counted)."""
-        boundary = Boundary(points=x, loops=loops, triangles=np.zeros((0, 3), int), detached=np.flatnonzero(free))
+        with weights ``w`` (m,); ``loops`` the boundary (node indices) and ``triangles`` (t, 3) the alpha
+        triangles that fill it (node indices; they move with the nodes like the loops, and are the surface
+        of the saved states). A point whose moment matrix is singular, or whose shape-function gradients
+        exceed GRADIENT_LIMIT / d_c (it extrapolates from a support on one side, where the nodes around it
+        have left the body), gets weight 0: it integrates nothing (counted)."""
+        boundary = Boundary(points=x, loops=loops, triangles=np.asarray(triangles, int).reshape(-1, 3),
+                            detached=np.flatnonzero(free))
         frame = build(x.copy(), boundary, points.copy(), w.copy(), self.lengths, active=np.flatnonzero(~free),
                       min_nodes=self.case.method.min_support, drop_singular=True)
         dropped = np.union1d(frame.sf.dropped, extrapolating_points(frame, self.d_c))

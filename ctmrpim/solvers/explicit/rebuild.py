@@ -71,7 +71,8 @@ class Rebuilds:
                 relay = False
         if new is None:
             try:
-                new = self.frame_at(self.x, old.free, old.moved_points(self.x), w_now, old.boundary.loops)
+                new = self.frame_at(self.x, old.free, old.moved_points(self.x), w_now, old.boundary.loops,
+                                    old.boundary.triangles)
             except ProblemError as exc:
                 raise Diverged(f"the rebuild at {when} failed: {exc.message}") from None
         self.timer.lap("rebuild")

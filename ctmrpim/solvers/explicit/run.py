@@ -221,9 +221,9 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
         n = len(self.X)
         return Result(
             method="ctm-rpim-explicit", points=self.X, u=self.x - self.X, stress=fields["stress"],
-            cells=[("line", final.edges)], counts={"nodes": n, "integration_points": len(self.frame.w),
-                                                   "steps": self.step, "rebuilds": self.rebuilds,
-                                                   "boundary_loops": len(final.loops)},
+            stress_zz=fields["szz"], cells=[("line", final.edges), ("triangle", final.triangles)],
+            counts={"nodes": n, "integration_points": len(self.frame.w), "steps": self.step, "rebuilds": self.rebuilds,
+                    "boundary_loops": len(final.loops)},
             timings=timings, history=self.history,
             fields={"velocity": fields["velocity"], "plastic_strain": fields["plastic_strain"]},
             parameters={**self.case.resolved, "derived": {"d_c": self.d_c, "alpha": self.lengths.alpha,

@@ -94,7 +94,8 @@ class RunState:
         fr = self.frame
         return {"x": self.x, "v": self.v, "frame_x": fr.x, "frame_free": fr.free,
                 "frame_points": fr.points, "frame_w": fr.w, "frame_loops": np.concatenate(fr.boundary.loops),
-                "frame_loop_sizes": [len(lp) for lp in fr.boundary.loops], "laid": self.laid, "stress": self.stress,
+                "frame_loop_sizes": [len(lp) for lp in fr.boundary.loops], "frame_triangles": fr.boundary.triangles,
+                "laid": self.laid, "stress": self.stress,
                 "plastic": self.plastic, "viscous": self.viscous, "F": self.F, "mode": self.mode}
 
     def _meta(self) -> dict[str, Any]:
@@ -117,7 +118,8 @@ class RunState:
         meta, a = load_checkpoint(self.out, self.key)
         self.x, self.v = a["x"], a["v"]
         loops = np.split(a["frame_loops"], np.cumsum(a["frame_loop_sizes"])[:-1])
-        self.frame = self.frame_at(a["frame_x"], a["frame_free"], a["frame_points"], a["frame_w"], loops)
+        self.frame = self.frame_at(a["frame_x"], a["frame_free"], a["frame_points"], a["frame_w"], loops,
+                                   a["frame_triangles"])
         self.stress, self.plastic, self.F, self.mode = a["stress"], a["plastic"], a["F"], a["mode"]
         self.viscous = a["viscous"]
         self.laid = a["laid"]
