@@ -96,6 +96,32 @@ def loaded_boundary(problem: Problem, nodes: np.ndarray, edges: np.ndarray, tol:
     return q, np.concatenate(tx_all), np.concatenate(ty_all)
 
 
+def tractions_at(problem: Problem, nodes: np.ndarray, q: BoundaryQuadrature, tol: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The dead tractions tx, ty (k,) of the problem's tractions and pressures at boundary points ``q`` of
+    another rule than :func:`loaded_boundary`'s (SCNI's cell edges), each point loaded where both ends of the
+    segment it lies on (``q.ends``) are selected, as there."""
+    x, y = nodes[:, 0], nodes[:, 1]
+    px, py = q.points[:, 0], q.points[:, 1]
+    tx, ty = np.zeros(len(px)), np.zeros(len(px))
+    for i, t in enumerate(problem.tractions):
+        if t.follower:
+            raise ProblemError("follower loads need a large-deformation analysis", key=f"traction[{i}].follower")
+        match = np.asarray(t.where(x, y, eq_tol=tol), bool)
+        on = match[q.ends[:, 0]] & match[q.ends[:, 1]]
+        if t.tx is not None:
+            tx[on] += _values(t.tx, px[on], py[on], f"traction[{i}].tx")
+        if t.ty is not None:
+            ty[on] += _values(t.ty, px[on], py[on], f"traction[{i}].ty")
+    for i, pr in enumerate(problem.pressures):
+        match = np.asarray(pr.where(x, y, eq_tol=tol), bool)
+        on = match[q.ends[:, 0]] & match[q.ends[:, 1]]
+        p = _values(pr.p, px[on], py[on], f"pressure[{i}].p")
+        tx[on] -= p * q.normals[on, 0]
+        ty[on] -= p * q.normals[on, 1]
+    return tx, ty
+
+
 def _turn_ends(ends: np.ndarray, face: np.ndarray, n_nodes: int) -> np.ndarray:
     """The node pair each loaded point's follower load turns with: its own segment, or for
     ``turn = "face"`` the two end nodes of the connected stretch of face-follower boundary it lies on

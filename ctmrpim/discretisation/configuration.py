@@ -26,10 +26,12 @@ from scipy.spatial import cKDTree
 
 from ctmrpim.discretisation import assembly
 from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape, validate
+from ctmrpim.discretisation.background_cells import cell_points
 from ctmrpim.discretisation.boundary_conditions import constrained_dofs, loaded_boundary
 from ctmrpim.discretisation.ctm import BoundaryQuadrature, Quadrature, integration_points
 from ctmrpim.discretisation.gradient_operator import GradientOperator
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator
+from ctmrpim.discretisation.nodal_integration import NodalIntegration, smoothed_gradients
 from ctmrpim.discretisation.rpim import ShapeFunctions, shape_functions
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.objective_stress import inv2
@@ -61,6 +63,7 @@ class Configuration:
     tree: cKDTree
     active: np.ndarray | None = None
     quadrature: Quadrature | None = None
+    nodal: NodalIntegration | None = None     # SCNI: the smoothing cells' boundary rule (points = the nodes)
     _G: sp.bsr_matrix | None = field(default=None, repr=False)
     _grad: GradientOperator | None = field(default=None, repr=False)
 
@@ -206,15 +209,41 @@ def reference_cloud(case: Case, timer: Timer) -> ReferenceCloud:
 
 
 def reference_configuration(case: Case, timer: Timer) -> Configuration:
-    """The :class:`Configuration` of the reference cloud, its CTM points laid over the tracked boundary
-    (``method.boundary = "alpha"``) or the exact geometry (``"geometry"``)."""
+    """The :class:`Configuration` of the reference cloud, integrated over the tracked boundary
+    (``method.boundary = "alpha"``) or the exact geometry (``"geometry"``) by ``method.integration``: CTM
+    points (``"ctm"``, ``"ctm-vci"``), background cells (``"cell-gauss"``) or the nodes' smoothing cells
+    (``"scni"``: the configuration's points are the nodes and its gradients the smoothed ones)."""
     cloud = reference_cloud(case, timer)
     loops = cloud.boundary.loop_coordinates() if case.method.boundary == "alpha" else case.problem.geometry.loops()
-    quad, w = lay_points(loops, cloud.lengths, case.problem.thickness)
+    thickness, scheme, lengths = case.problem.thickness, case.method.integration, cloud.lengths
+    if scheme == "scni":
+        return _nodal_configuration(cloud, loops, thickness, timer)
+    quad = None
+    if scheme == "cell-gauss":
+        points, w = cell_points(loops, lengths.r_x, lengths.r_y, lengths.gauss_points)
+        w = w * thickness
+    else:
+        quad, w = lay_points(loops, lengths, thickness)
+        points = quad.points
     timer.lap("integration")
-    conf = build(cloud.nodes, cloud.boundary, quad.points, w, cloud.lengths, quadrature=quad)
+    conf = build(cloud.nodes, cloud.boundary, points, w, lengths, quadrature=quad)
     timer.lap("shape_functions")
     return conf
+
+
+def _nodal_configuration(cloud: ReferenceCloud, loops: list[np.ndarray], thickness: float,
+                         timer: Timer) -> Configuration:
+    """SCNI (:mod:`ctmrpim.discretisation.nodal_integration`): the nodes as integration points with their
+    smoothing cells' areas, N = I there (the Kronecker delta property), the smoothed gradients."""
+    nodes, lengths = cloud.nodes, cloud.lengths
+    tree = cKDTree(nodes)
+    values = lambda pts: shape_functions(nodes, pts, derivatives=False, tree=tree, **lengths.rpim()).N
+    nodal = smoothed_gradients(nodes, loops, cloud.boundary.edges, values)
+    timer.lap("integration")
+    sf = ShapeFunctions(sp.identity(len(nodes), format="csr"), nodal.bx, nodal.by, np.diff(nodal.bx.indptr))
+    timer.lap("shape_functions")
+    return Configuration(nodes, lengths, cloud.boundary, nodes.copy(), nodal.areas * thickness, sf, tree,
+                         nodal=nodal)
 
 
 @dataclass

@@ -22,8 +22,10 @@ BOUNDARIES = ("alpha", "geometry")
 LINEAR_SOLVERS = ("auto", "banded", "superlu", "spsolve")
 #: large-deformation (quasi-static) formulations: the paper's adaptive one, and the cross-check
 FORMULATIONS = ("updated-lagrangian", "total-lagrangian")
-#: integration schemes: the paper's CTM, and CTM with variationally consistent test gradients (VCI)
-INTEGRATIONS = ("ctm", "ctm-vci")
+#: integration schemes: the paper's CTM, CTM with variationally consistent test gradients (VCI), and two
+#: comparators of linear analyses: background cells clipped by the boundary, and stabilised conforming
+#: nodal integration
+INTEGRATIONS = ("ctm", "ctm-vci", "cell-gauss", "scni")
 #: ``method.integration`` where the file does not set it, by analysis: the consistent scheme where it is
 #: implemented (linear analyses), the paper's elsewhere
 DEFAULT_INTEGRATION = {"linear": "ctm-vci"}

@@ -11,8 +11,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from ctmrpim.discretisation import assembly, consistent_integration
+from ctmrpim.discretisation.boundary_conditions import tractions_at
 from ctmrpim.discretisation.configuration import BoundaryTags, Configuration, boundary_tags, reference_configuration
 from ctmrpim.discretisation.ctm import integration_points
+from ctmrpim.discretisation.rpim import ShapeFunctions
 from ctmrpim.discretisation.stress_recovery import recovered_stress
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
@@ -45,6 +47,24 @@ def consistent_stiffness(case: Case, conf: Configuration, tags: BoundaryTags, D:
     return K - consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, boundary, sf_b, D, thickness)
 
 
+def nodal_stiffness_and_load(case: Case, conf: Configuration, tags: BoundaryTags, D: np.ndarray
+                             ) -> tuple[sp.csr_matrix, np.ndarray]:
+    """K (2n x 2n) and the traction load (2n,) of ``method.integration = "scni"``
+    (:mod:`ctmrpim.discretisation.nodal_integration`): K = sum_I B~_I^T D B~_I A_I minus the Dirichlet
+    consistency term with the smoothed stress of each boundary cell, and the tractions on the same cell
+    edges the smoothing integrates over, so that the divergence identity holds and the patch test passes."""
+    if case.method.boundary != "alpha":
+        raise ProblemError("method.integration = \"scni\" smooths over cells clipped by the node loops of the tracked "
+                           "boundary: set method.boundary = \"alpha\"", key="method.integration")
+    nodal, thickness = conf.nodal, case.problem.thickness
+    q = nodal.boundary
+    trial = ShapeFunctions(nodal.N_boundary, nodal.bx[nodal.owner], nodal.by[nodal.owner], np.zeros(0))
+    K = assembly.stiffness(nodal.bx, nodal.by, conf.w, D)
+    K = K - consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, q, trial, D, thickness)
+    tx, ty = tractions_at(case.problem, conf.x, q, conf.lengths.match_tolerance)
+    return K, assembly.load_vector(nodal.N_boundary, q.weights * thickness, tx, ty)
+
+
 def solve_ctmrpim(case: Case) -> Result:
     """Solve a linear-elastic Case with CTM-RPIM."""
     problem, method = case.problem, case.method
@@ -57,17 +77,22 @@ def solve_ctmrpim(case: Case) -> Result:
     fixed, fixed_values, traction_q = tags.fixed, tags.fixed_values, tags.traction
 
     D = problem.D()
-    consistent = method.integration == "ctm-vci"
-    K = consistent_stiffness(case, conf, tags, D) if consistent else assembly.stiffness(sf.dNdx, sf.dNdy, conf.w, D)
-    F = assembly.load_vector(N_traction, traction_q.weights * problem.thickness, tags.tx, tags.ty)
+    scheme = method.integration
+    if scheme == "scni":
+        K, F = nodal_stiffness_and_load(case, conf, tags, D)
+    else:
+        K = (consistent_stiffness(case, conf, tags, D) if scheme == "ctm-vci"
+             else assembly.stiffness(sf.dNdx, sf.dNdy, conf.w, D))
+        F = assembly.load_vector(N_traction, traction_q.weights * problem.thickness, tags.tx, tags.ty)
     F += problem.thickness * conf.point_forces(problem)
     F += assembly.body_force_vector(sf.N, conf.w, problem)
     if problem.body_load is not None:
         F += assembly.load_vector(sf.N, conf.w, *problem.body_load.at(conf.points).T)
     timer.lap("assembly")
 
-    # K of the consistent scheme is not symmetric: no Cholesky
-    U = solve_constrained(K, F, fixed, fixed_values, "superlu" if consistent and method.solver in ("auto", "banded")
+    # K of the consistent schemes (their Dirichlet terms) is not symmetric: no Cholesky
+    symmetric = scheme in ("ctm", "cell-gauss")
+    U = solve_constrained(K, F, fixed, fixed_values, "superlu" if not symmetric and method.solver in ("auto", "banded")
                           else method.solver)
     u = U.reshape(-1, 2)
     timer.lap("solve")
@@ -97,7 +122,8 @@ def solve_ctmrpim(case: Case) -> Result:
         method="ctm-rpim", points=nodes, u=u, stress=stress, stress_zz=out_of_plane_stress(problem, stress),
         cells=[("line", boundary.edges), ("triangle", boundary.triangles)],
         probes=probes, errors=errors,
-        counts={"nodes": len(nodes), "integration_points": len(quad.weights), "integration_lines": quad.n_lines,
+        counts={"nodes": len(nodes), "integration_points": len(conf.w),
+                "integration_lines": quad.n_lines if quad is not None else 0,
                 "traction_points": len(traction_q.weights), "boundary_loops": len(boundary.loops),
                 "boundary_nodes": len(tags.boundary_nodes), "holes_filled": boundary.filled_holes,
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())},
