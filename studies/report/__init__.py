@@ -15,6 +15,7 @@ from pathlib import Path
 
 import studies
 from ctmrpim.io.atomic import atomic_write_text
+from studies.integration_schemes import scheme_table
 from studies.report import dynamics, large_deformation, linear, stability, summary
 from studies.report.checks import all_checks, claims_table, console_summary
 from studies.report.markdown import Progress
@@ -41,6 +42,7 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     linear.write_time_to_accuracy(w, targets_table(tables["time_to_accuracy"]))
     linear.write_parameter_studies(w, tables)
     linear.write_plate_hole(w, tables["plate_hole_convergence"])
+    linear.write_integration_schemes(w, tables["integration_schemes"], scheme_table(tables["integration_schemes"]))
     large_deformation.write_tip_load(w, tables["tip_load"])
     large_deformation.write_end_moment(w, tables["end_moment"])
     large_deformation.write_deformed_shapes(w, quick, out_dir, progress)

@@ -92,3 +92,36 @@ def write_plate_hole(w: Writer, plate: pd.DataFrame) -> None:
         w(f" {method}: the concentration's error {'falls' if falls else 'does not fall'} at every refinement of "
           f"this run ({', '.join(f'{e:.3f}' for e in error)}).")
     w("\n\n")
+
+
+def write_integration_schemes(w: Writer, df: pd.DataFrame, table: pd.DataFrame) -> None:
+    """The integration schemes side by side (``table``: ``integration_schemes.scheme_table``), with which wins
+    where, every number read from the study's rows."""
+    w("## Integration schemes side by side (not in the paper)\n\n")
+    w(studies.study("integration_schemes").__doc__.strip() + "\n\n")
+    shown = table.assign(
+        patch_error=table.patch_error.map(lambda v: f"{v:.1e}"),
+        energy_rate=table.energy_rate.map(lambda v: f"{v:.2f}"),
+        finest_energy_error=table.finest_energy_error.map(lambda v: f"{100 * v:.3g} %"),
+        **{"time_to_0.1%_energy_s": table["time_to_0.1%_energy_s"].map(lambda v: "not reached" if np.isnan(v)
+                                                                         else f"{v:.3f} s")})
+    w(md(shown))
+    t = table.set_index("setting")
+    exact = t.index[t.patch_error <= 1e-8].tolist()
+    fastest = t["time_to_0.1%_energy_s"].dropna().sort_values()
+    best_rate = t.energy_rate.idxmax()
+    w(f"\n\nPatch test to round-off: {', '.join(exact) if exact else 'none'}; the others fail it by "
+      f"{t.patch_error[t.patch_error > 1e-8].min():.1e} to {t.patch_error.max():.1e} (relative). "
+      f"Highest energy-error rate: {best_rate} ({t.energy_rate[best_rate]:.2f}). ")
+    if len(fastest):
+        w(f"First to 0.1 % energy error on the cantilever: {fastest.index[0]} in {fastest.iloc[0]:.3f} s")
+        w(f"; {', '.join(fastest.index[1:])} also reach it.\n\n" if len(fastest) > 1 else
+          "; no other setting reaches it on these grids.\n\n")
+    else:
+        w("No setting reaches 0.1 % energy error on these grids.\n\n")
+    ok = df[(df.status == "ok") & (df.problem == "plate-hole")]
+    if len(ok):
+        finest = ok[ok.h == ok.h.min()].set_index("setting")
+        w(f"Plate with a hole at spacing {ok.h.min():g}, stress concentration sxx(0, a) / T (exact 3): "
+          + ", ".join(f"{s} {v / 1000:.3f}" for s, v in finest.sxx_hole_top.items()) + ".\n\n")
+    w("![integration schemes](integration_schemes.png)\n\n")
