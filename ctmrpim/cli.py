@@ -5,24 +5,33 @@ A thin layer over the public API (:func:`ctmrpim.load_case`, :func:`ctmrpim.solv
 is a function that adds its subcommands to the parser (the verification suite in ``studies/`` adds
 ``study`` and ``report``), so this package never imports the application built on it.
 
-User mistakes (a bad problem file, an unknown benchmark, a selector that matches nothing) end with
-one line on stderr naming the file, key and reason, exit status 2, no traceback, and nothing written.
+Exit status: 0 done; 2 bad input (a bad problem file, an unknown benchmark, a selector that matches
+nothing: one line on stderr naming the file, key and reason, no traceback, and nothing written); 3 the solve
+did not converge (one line; ``summary.json`` holds the history up to there and ``status.json`` says "not
+converged"); 130 interrupted (Ctrl-C: ``status.json`` says "interrupted", no traceback). The output folder
+holds one run, with its status record (:mod:`ctmrpim.io.run_folder`); while a solve runs, its phases and
+steps are shown on stderr (:mod:`ctmrpim.progress`; ``--quiet`` silences them).
 """
 from __future__ import annotations
 
 import argparse
+import math
+import shlex
 import sys
+import time
 import warnings
 from importlib.metadata import entry_points
 from pathlib import Path
 
 import ctmrpim.benchmarks as benchmarks
 import ctmrpim.methods as methods
+from ctmrpim import progress
 from ctmrpim.cases import load_case
-from ctmrpim.errors import ProblemError
-from ctmrpim.io.run_folder import write_outputs
+from ctmrpim.errors import ConvergenceError, ProblemError
+from ctmrpim.io.run_folder import RunFolder, default_folder
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result
+from ctmrpim.version import __version__
 
 #: entry-point group of commands that applications add to ``ctmrpim``
 COMMANDS = "ctmrpim.commands"
@@ -51,7 +60,7 @@ def describe(result: Result, case: Case) -> str:
         lines.append(line)
     if "l2" in result.errors or "energy" in result.errors:
         lines.append("  relative errors: " + ", ".join(
-            f"{k} {100 * result.errors[k]:.4g} %" for k in ("l2", "energy") if k in result.errors))
+            f"{k} {_percent(result.errors[k])}" for k in ("l2", "energy") if k in result.errors))
     fos = result.outcome.get("factor_of_safety")
     if fos is not None:
         lines.append(f"  {c['levels']} strength-reduction levels ({fos['mode']}), {c['newton_iterations']} iterations, "
@@ -110,6 +119,11 @@ def describe(result: Result, case: Case) -> str:
     return "\n".join(lines)
 
 
+def _percent(value: float) -> str:
+    """A relative error as a percentage; "undefined" where it is not a number (the exact reference is zero)."""
+    return f"{100 * value:.4g} %" if math.isfinite(value) else "undefined (the exact value is zero)"
+
+
 def _level_line(h: dict) -> str:
     state = "stable" if h["stable"] else "FAILED"
     if h.get("criterion"):
@@ -132,23 +146,59 @@ def _description(name: str) -> str:
     return tomllib.loads(benchmarks.path(name).read_text()).get("problem", {}).get("description", "")
 
 
+def _title(case: Case, method: str) -> str:
+    """How the progress display names a run: problem, analysis, method and the node specification."""
+    nodes = case.resolved.get("nodes", {})
+    if "grid" in nodes:
+        spec = " x ".join(str(k) for k in nodes["grid"]) + " nodes"
+    elif "spacing" in nodes:
+        spec = f"node spacing {nodes['spacing']:g}"
+    elif "file" in nodes:
+        spec = f"nodes from {nodes['file']}"
+    else:
+        spec = ""
+    return f"{case.problem.name} ({', '.join(p for p in (case.problem.analysis, method, spec) if p)})"
+
+
 def cmd_run(args: argparse.Namespace) -> int:
-    """``ctmrpim run TARGET``: solve a benchmark or problem file, write its outputs, print a summary; exit status 0."""
+    """``ctmrpim run TARGET``: solve a benchmark or problem file into its output folder, print a summary; exit
+    status 0, or 3 when the solve did not converge (bad input raises a ProblemError: 2)."""
     case = load_case(args.target, args.set or [])
     element = methods.element_of(methods.get(args.solver), args.element)
     suffix = "" if args.solver == methods.DEFAULT else f"-{args.solver}" + (f"-{element}" if element else "")
-    out = Path(args.out) if args.out else Path("runs") / f"{case.problem.name}{suffix}"
+    out = Path(args.out) if args.out else default_folder(args.target, case, args.target in benchmarks.names(),
+                                                         suffix)
     if args.resume and case.problem.analysis != "explicit":
         raise ProblemError("--resume continues an explicit dynamic run from its checkpoint; this analysis is "
                            f"{case.problem.analysis!r}", key="--resume")
+    method = args.solver + (f"-{element}" if element else "")
+    folder = RunFolder(out, command=shlex.join(["ctmrpim", *args.argv]), source=case.source, method=method,
+                       resume=args.resume)
+    folder.start()
+    reporter = progress.SILENT if args.quiet else progress.Progress(title=_title(case, method), name=case.problem.name)
     try:
-        progress = None if args.quiet else (lambda level: print("  " + _level_line(level.record()), file=sys.stderr,
-                                                                    flush=True))
-        result = methods.solve(case, args.solver, args.element, progress=progress, out=out, resume=args.resume,
-                               progress_bar=not args.quiet)
+        with progress.reporting(reporter):
+            levels = None if args.quiet else (lambda level: reporter.line("  " + _level_line(level.record())))
+            result = methods.solve(case, args.solver, args.element, progress=levels, out=out, resume=args.resume,
+                                   progress_bar=not args.quiet)
+            start = time.perf_counter()
+            paths = folder.write_result(result, case)
+            reporter.phase("output", time.perf_counter() - start)
+    except ConvergenceError as exc:      # accepted input, a solve that gave up: keep what it got through
+        exc = exc.at(source=case.source)
+        summary = folder.not_converged(exc, case)
+        print(f"ctmrpim: not converged: {' '.join(exc.message.splitlines())} (the history up to there is in "
+              f"{summary})", file=sys.stderr)
+        return 3
     except ProblemError as exc:  # raised while solving, e.g. a selector that matches no node: name the file
+        folder.discard()
         raise exc.at(source=case.source) from None
-    paths = write_outputs(result, case, out)
+    except KeyboardInterrupt:
+        folder.finish("interrupted", 130, error="interrupted")
+        raise
+    except BaseException as exc:     # a bug: the record says so, the traceback follows
+        folder.finish("failed", 1, error=f"{type(exc).__name__}: {exc}")
+        raise
     if not args.quiet:
         print(describe(result, case))
         shown = [p for p in paths if p.parent.name != "series"]
@@ -160,18 +210,20 @@ def cmd_run(args: argparse.Namespace) -> int:
 def build_parser() -> argparse.ArgumentParser:
     """The ``ctmrpim`` argument parser: ``list``, ``run`` and the commands of the ``ctmrpim.commands`` entry points."""
     ap = argparse.ArgumentParser(prog="ctmrpim", description="Adaptive CTM-RPIM meshfree solver and verification suite")
+    ap.add_argument("--version", action="version", version=f"ctmrpim {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
     p = sub.add_parser("list", help="list the benchmark problems")
     p.set_defaults(func=cmd_list)
     p = sub.add_parser("run", help="solve a benchmark or a TOML problem file")
     p.add_argument("target", help="benchmark name (see `ctmrpim list`) or path to a problem file")
-    p.add_argument("--out", help="output folder (default runs/NAME)")
+    p.add_argument("--out", help="output folder, holding this run only: an earlier run's files there are removed "
+                                 "(default runs/NAME for a benchmark, runs/STEM-HASH for a problem file)")
     p.add_argument("--set", action="append", metavar="SECTION.KEY=VALUE",
                    help="override a problem-file value, e.g. --set nodes.grid=[65,17] (repeatable)")
     p.add_argument("--solver", choices=methods.names(), default=methods.DEFAULT,
                    help="the method (default ctm-rpim; fem: the scikit-fem reference)")
     p.add_argument("--element", help="element of a finite-element method: q1, p1 or p2 for fem (default q1)")
-    p.add_argument("--quiet", action="store_true", help="print nothing on success")
+    p.add_argument("--quiet", action="store_true", help="print nothing on success (no progress either)")
     p.add_argument("--resume", action="store_true",
                    help="explicit dynamics: continue from the checkpoint in the output folder")
     p.set_defaults(func=cmd_run)
@@ -181,16 +233,26 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line on ``argv`` (default ``sys.argv[1:]``); exit status 0, 2 on a ProblemError, 130 when
-    interrupted."""
+    """Run the command line on ``argv`` (default ``sys.argv[1:]``); exit status 0, 2 on a ProblemError, 3 when a
+    solve did not converge, 130 when interrupted."""
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
+    args.argv = argv
     with warnings.catch_warnings():
         warnings.simplefilter("always", UserWarning)
+        # a relative error whose exact reference is zero is 0/0 or x/0 (ctmrpim/reference/error_norms.py):
+        # summary.json writes it as null with a note, so numpy's warning about it only alarms
+        warnings.filterwarnings("ignore", r"(divide by zero|invalid value) encountered", RuntimeWarning,
+                                r"ctmrpim\.reference\.error_norms")
         library_show = warnings.showwarning
 
         def show(message, category, *rest, **kw):
             if issubclass(category, UserWarning):  # ctmrpim's own advice to the user: one plain line
-                print(f"ctmrpim: warning: {message}", file=sys.stderr)
+                reporter = progress.current()
+                if isinstance(reporter, progress.Progress) and reporter.live:   # not through the live line
+                    reporter.line(f"ctmrpim: warning: {message}")
+                else:
+                    print(f"ctmrpim: warning: {message}", file=sys.stderr)
             else:
                 library_show(message, category, *rest, **kw)
 

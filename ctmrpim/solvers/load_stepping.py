@@ -10,7 +10,10 @@ predictor, the last converged increment's displacement scaled to the new load st
 rotates, and the tangent predictor alone stretches it (the first residual then grows a hundredfold and
 Newton needs 10-15 iterations per increment; with the secant predictor 3-5). An increment that does not converge (or inverts the
 material) is halved and retried, and the history says so, never silently; after an easy increment
-a cut-back step grows back towards 1/steps.
+a cut-back step grows back towards 1/steps. When an increment cannot be cut back any further the solve
+gives up with a :class:`~ctmrpim.errors.ConvergenceError` carrying the history so far (the CLI writes it
+and exits with status 3), unless the caller asked for the failure as an answer (a limit load, a
+strength-reduction level). Each iteration is shown by the progress reporter (:mod:`ctmrpim.progress`).
 """
 from __future__ import annotations
 
@@ -20,7 +23,8 @@ from typing import Any, Callable
 import numpy as np
 import scipy.sparse as sp
 
-from ctmrpim.errors import ProblemError
+from ctmrpim import progress
+from ctmrpim.errors import ConvergenceError, ProblemError
 from ctmrpim.problem.settings import Loading
 
 #: Newton has diverged when a later step exceeds this many times both the increment's first step and
@@ -89,9 +93,9 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
     fixed dofs; ``on_converged(factor, U)`` returns the extra history entries of a converged increment
     (probe values) and may record the state. The path starts from ``U0`` (default zero) and the
     prescribed displacements go linearly from their values in U0 to ``fixed_values``. When the
-    increment cannot be cut back any further the solve raises a ProblemError, or with
-    ``stop_on_failure`` returns the path so far with ``failed_at`` set (a limit load, a failed
-    strength-reduction level).
+    increment cannot be cut back any further the solve raises a ConvergenceError with the history so
+    far, or with ``stop_on_failure`` returns the path so far with ``failed_at`` set (a limit load, a
+    failed strength-reduction level).
 
     ``anderson = m > 0`` mixes each Newton step with the last m (Anderson acceleration of the
     fixed-point map U -> U + K^-1 r(U), restarted whenever ``assemble`` returns a new K): perfect
@@ -102,6 +106,7 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
     start_values = path.U[fixed].copy()
     factor, dfactor = 0.0, 1.0 / steps
     last_step, last_dfactor = None, 0.0
+    report = progress.current()
     while factor < 1.0 - 1e-12:
         target = min(1.0, factor + dfactor)
         trial, converged, it = path.U.copy(), False, 0
@@ -120,6 +125,8 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
             residual = f_ext - f_int
             scale = max(ref, np.linalg.norm(f_int))   # reactions carry a displacement-driven load
             residual[fixed] = 0.0
+            report.status(f"load factor {target:.4g}: Newton iteration {it}, residual "
+                          f"{np.linalg.norm(residual) / scale:.2e} of the loads ({path.cutbacks} cut-back(s) so far)")
             du = solve(K, residual)
             if not np.all(np.isfinite(du)):
                 raise ProblemError("the tangent stiffness is singular: the constraints do not stop every "
@@ -137,13 +144,15 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
                 break
         if not converged:
             if path.cutbacks >= loading.max_cutbacks:
+                path.history.append({"load_factor": target, "converged": False, "iterations": it,
+                                     "note": f"no convergence after {loading.max_cutbacks} cut-backs"})
+                report.status("")
                 if stop_on_failure:
                     path.failed_at, path.failed_trial = target, trial
-                    path.history.append({"load_factor": target, "converged": False, "iterations": it,
-                                         "note": f"no convergence after {loading.max_cutbacks} cut-backs"})
                     return path
-                raise ProblemError(f"Newton did not converge at load factor {target:.4g} after "
-                                   f"{loading.max_cutbacks} cut-backs; use more load steps", key="loading")
+                raise ConvergenceError(f"Newton did not converge at load factor {target:.4g} after "
+                                       f"{loading.max_cutbacks} cut-backs; use more load steps", key="loading",
+                                       history=path.history)
             path.cutbacks += 1
             dfactor *= 0.5
             path.history.append({"load_factor": target, "converged": False, "iterations": it,
@@ -155,4 +164,5 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
             dfactor = min(2.0 * dfactor, 1.0 / steps)
         path.history.append({"load_factor": factor, "converged": True, "iterations": it,
                              **on_converged(factor, path.U)})
+    report.status("")
     return path

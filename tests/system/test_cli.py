@@ -73,7 +73,7 @@ def test_list(tmp_path: Path) -> None:
 
 def test_run_prints_a_summary_and_writes_both_files(run) -> None:
     proc, out, _ = run
-    assert sorted(p.name for p in out.iterdir()) == ["result.vtu", "summary.json"]   # no temporary files left
+    assert sorted(p.name for p in out.iterdir()) == ["result.vtu", "status.json", "summary.json"]   # no temporary files
     assert proc.stderr == ""
     text = proc.stdout
     assert text.startswith("cantilever (ctm-rpim): 297 nodes, d_c = 1.395")
@@ -93,7 +93,7 @@ def test_summary_holds_the_resolved_input(run) -> None:
     assert p["parameters"] == {"P": -1000.0, "E": 3.0e7, "nu": 0.3, "L": 48.0, "W": 12.0, "I": 144.0}
     assert p["geometry"] == {"add": [{"rectangle": [0.0, -6.0, 48.0, 6.0]}], "subtract": []}
     assert p["nodes"] == {"grid": [33, 9]}
-    assert p["material"] == {"model": "linear-elastic", "E": 3.0e7, "nu": 0.3, "density": 1.0}
+    assert p["material"] == {"model": "linear-elastic", "E": 3.0e7, "nu": 0.3, "density": 0.0}
     assert p["method"] == {"support_radius": 4.0, "eta": 5.0, "polynomial": "linear", "line_spacing": [1 / 3, 1 / 3],
                            "gauss_points": 1, "alpha": 1.5, "boundary": "alpha", "solver": "auto",
                            "match_tolerance": 0.01, "formulation": "updated-lagrangian", "point_regeneration": 0.0,
@@ -104,7 +104,8 @@ def test_summary_holds_the_resolved_input(run) -> None:
     assert p["derived"]["d_c"] == pytest.approx(d_c, rel=1e-14)
     assert p["derived"]["support_radius"] == pytest.approx(4.0 * d_c, rel=1e-14)
     # the defaults that were applied are listed
-    assert s["defaults_applied"] == ["problem.gravity = [0.0, 0.0]", "method.boundary = 'alpha'", "method.solver = 'auto'",
+    assert s["defaults_applied"] == ["problem.gravity = [0.0, 0.0]", "material.density = 0.0",
+                                     "method.boundary = 'alpha'", "method.solver = 'auto'",
                                      "method.match_tolerance = 0.01", "method.formulation = 'updated-lagrangian'",
                                      "method.point_regeneration = 0.0", "method.min_support = 0",
                                      "method.integration = 'ctm-vci'", "method.correction = 'quadratic'"]
@@ -168,7 +169,7 @@ def test_vtu_round_trip(run, api) -> None:
 def test_fem_q1(tmp_path: Path, run, in_process) -> None:
     _, stdout, _ = in_process("run", "cantilever", "--solver", "fem", "--element", "q1", "--out", str(tmp_path / "o"))
     assert stdout.startswith("cantilever (fem-q1): 297 nodes")
-    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["result.vtu", "summary.json"]
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["result.vtu", "status.json", "summary.json"]
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert s["method"] == "fem-q1" and s["parameters"]["derived"]["element"] == "q1"
     assert set(s["probes"]["tip"]) == {"x", "y", "ux", "uy", "sxx", "syy", "sxy"}

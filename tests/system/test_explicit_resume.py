@@ -69,13 +69,18 @@ def test_resume_needs_the_same_problem(tmp_path):
 
 
 def test_divergence_names_what_where_and_when(tmp_path, capsys):
-    """A time step far above the stable one: the run stops with the step, time and place, exit 2, no
-    summary, and the checkpoint it had stays."""
+    """A time step far above the stable one: the run stops with the step, time and place in one line, exit 3
+    (the input was accepted, the solve did not converge), the status and the summary say "not converged"
+    with the history up to there, and no result.vtu is written."""
     out = tmp_path / "bad"
     code = main(["run", "column-collapse", "--set", "nodes.grid=[16, 9]", "--set", "explicit.dt=5e-3",
                  "--set", "explicit.initial=\"none\"", "--out", str(out), "--quiet"])
     stderr = capsys.readouterr().err
-    assert code == 2
-    assert "Traceback" not in stderr
-    assert "step" in stderr and "t = " in stderr
-    assert not (out / "summary.json").exists()
+    assert code == 3
+    assert "Traceback" not in stderr and len(stderr.splitlines()) == 1
+    assert stderr.startswith("ctmrpim: not converged: ") and "step" in stderr and "t = " in stderr
+    assert not (out / "result.vtu").exists()
+    status = json.loads((out / "status.json").read_text())
+    summary = json.loads((out / "summary.json").read_text())
+    assert status["state"] == summary["status"] == "not converged" and status["exit_status"] == 3
+    assert "t = " in summary["error"] and summary["history"]

@@ -36,24 +36,29 @@ first steps would shake the column before the gate goes). The damped stage gives
 equilibrium itself, yielded where the material must yield.
 
 **Long runs** (docs/design.md, 'Explicit dynamics'): a VTU per ``save_every`` seconds and a ``.pvd`` index
-written as the run goes; a progress bar; a checkpoint every ``checkpoint_every`` steps from which
-``--resume`` continues bit for bit (the frame is rebuilt from x_r; BLAS pinned to one thread); a run that
-diverges (non-finite values, an inverted point, a node that left the body, a jump of the tracked area)
-stops with what, where and when, and its last checkpoint is left as it was.
+written as the run goes; its progress (stage, simulated time, step, time step, rebuilds, kinetic energy) as
+the status of the progress reporter (:mod:`ctmrpim.progress`: a live line on a terminal, a line every few
+seconds in a log); a checkpoint every ``checkpoint_every`` steps from which ``--resume`` continues bit for
+bit (the frame is rebuilt from x_r; BLAS pinned to one thread); a run that diverges (non-finite values, an
+inverted point, a node that left the body, a jump of the tracked area) stops with what, where and when and
+the history up to there (:class:`~ctmrpim.solvers.explicit.errors.Diverged`, a ConvergenceError), and its
+last checkpoint is left as it was.
 """
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
 
+from ctmrpim import progress as _progress
 from ctmrpim.discretisation.alpha_shape import alpha_shape
 from ctmrpim.discretisation.boundary_conditions import constrained_dofs
 from ctmrpim.discretisation.configuration import reference_cloud
 from ctmrpim.discretisation.lumped_mass import lumped_mass
 from ctmrpim.errors import ProblemError
-from ctmrpim.io.checkpoint import NAME as CHECKPOINT
+from ctmrpim.io.atomic import atomic_write_text
+from ctmrpim.io.run_folder import SERIES, STEP, remove_outputs
+from ctmrpim.io.vtu import pvd_text
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.model import Wall
@@ -71,6 +76,8 @@ from ctmrpim.timing import Timer
 
 #: History records per simulated second (at most; every step is cheaper to record than to skip here).
 RECORDS_PER_SECOND = 500
+#: The progress status is refreshed every this many steps (a status is cheap, but not free at every step).
+STATUS_EVERY = 50
 
 
 class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebuilds, StoredEnergy, SeriesOutput):
@@ -117,17 +124,18 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
             raise ProblemError("explicit.viscosity with a tension cut-off (material.tension) is not implemented",
                                key="explicit.viscosity")
         self.dropped_points = 0
-        self.timer.lap("set_up")
+        self.timer.lap("set_up", nodes=n)
 
     # -- driver ----------------------------------------------------------------------------------------
     def run(self, progress: bool = True) -> None:
         """Run from the present state: the gravity stage until at rest (if not over), then the dynamics
-        until ``duration`` or at rest, saving, recording and checkpointing as set."""
+        until ``duration`` or at rest, saving, recording and checkpointing as set; ``progress``: report each
+        :data:`STATUS_EVERY` steps to the progress reporter in force."""
         s = self.settings
-        bar = _bar(progress, s.duration)
+        report = _progress.current() if progress else _progress.SILENT
         try:
             if self.stage == "gravity":
-                bar.set_description("gravity stage")
+                report.status("gravity stage: starting")
                 while self.stage_residual > s.stage_tolerance:
                     if self.stage_steps >= s.stage_steps:
                         raise Diverged(f"the gravity stage did not come to rest in {s.stage_steps} steps "
@@ -137,10 +145,14 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
                     self.stage_steps += 1
                     self.rebuild_if_needed()
                     self._maybe_checkpoint()
+                    if self.stage_steps % STATUS_EVERY == 0:
+                        report.status(f"gravity stage: step {self.stage_steps}, out-of-balance force "
+                                      f"{self.stage_residual:.2e} of the weight (to {s.stage_tolerance:g}), "
+                                      f"{self.rebuilds} rebuilds")
                 self._begin_dynamics()
-            bar.set_description("collapse" if any(w.gate for w in self.walls) else "dynamics")
+            stage = "collapse" if any(w.gate for w in self.walls) else "dynamics"
             walls = [w for w in self.walls if not w.gate]
-            bar.update(self.t)
+            report.status(f"{stage}: t = {self.t:.4f} of {s.duration:g} s simulated, step {self.step}")
             while self.t < s.duration - 1e-12 * s.duration and not self.at_rest:
                 self.advance(walls, s.damping)
                 ke = self.kinetic_energy()
@@ -154,14 +166,18 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
                     self.save()
                     self.next_save += s.save_every
                 self._maybe_checkpoint()
-                bar.update(self.dt)
-                if self.step % 50 == 0:
-                    bar.set_postfix_str(f"step {self.step}, dt {self.dt:.2e} s, {self.rebuilds} rebuilds, "
-                                        f"KE {ke:.3g} J")
+                if self.step % STATUS_EVERY == 0:
+                    report.status(f"{stage}: t = {self.t:.4f} of {s.duration:g} s simulated "
+                                  f"({100 * self.t / s.duration:.0f} %), step {self.step}, dt {self.dt:.2e} s, "
+                                  f"{self.rebuilds} rebuilds, kinetic energy {ke:.3g} J, {len(self.series.entries)} "
+                                  "states saved")
             if not self.series.entries or self.series.entries[-1][0] < self.t:
                 self.save()
+        except Diverged as exc:     # the history up to here goes to summary.json beside the reason
+            exc.history = list(self.history)
+            raise
         finally:
-            bar.close()
+            report.status("")
 
     def _begin_dynamics(self) -> None:
         """End of the gravity stage: at rest, t = 0, gates removed, accounts opened."""
@@ -231,12 +247,6 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
             defaults=self.case.defaults, outcome={"dynamics": dynamics})
 
 
-def _bar(enabled: bool, total: float):
-    from tqdm import tqdm
-    return tqdm(total=total, disable=not enabled, unit="s", unit_scale=False, leave=False, mininterval=0.5,
-                bar_format="{desc}: {n:.3f}/{total:.3f} s simulated |{bar}| {elapsed}<{remaining} {postfix}")
-
-
 def solve_explicit(case: Case, out: Path, resume: bool = False, progress: bool = False) -> Result:
     """Run the explicit dynamic analysis of ``case`` into the folder ``out`` (series, checkpoints);
     ``resume`` continues from the folder's checkpoint. BLAS is pinned to one thread, so that a resumed
@@ -246,16 +256,29 @@ def solve_explicit(case: Case, out: Path, resume: bool = False, progress: bool =
     out = Path(out)
     run = ExplicitRun(case, out, input_key(case))
     with threadpool_limits(1):
+        # until this run ends nothing looks complete, and no state of an earlier run stays (only files a run
+        # writes are removed; a resumed run keeps the checkpoint and series it continues)
+        out.mkdir(parents=True, exist_ok=True)
+        remove_outputs(out, resume)
         if resume:
             run.resume()
+            _prune_series(out, run.series.entries)
         else:
-            if (out / "series").is_dir():
-                shutil.rmtree(out / "series")     # a fresh run: no stale states of an earlier one
-            for name in (CHECKPOINT, "result.pvd"):
-                (out / name).unlink(missing_ok=True)
             run.start()
-        for name in ("summary.json", "result.vtu"):   # until this run ends, nothing looks complete
-            (out / name).unlink(missing_ok=True)
         run.run(progress)
         return run.result()
+
+
+def _prune_series(out: Path, entries: list[tuple[float, str]]) -> None:
+    """Remove the states a killed run saved after its last checkpoint (``series/`` files not among the
+    checkpoint's ``entries``, (time, file)) and rewrite the index to match: the resumed run writes them again,
+    and the folder never lists or holds a state the resumed run did not reach."""
+    listed = {name for _, name in entries}
+    series = out / SERIES
+    if series.is_dir():
+        for p in series.iterdir():
+            if STEP.fullmatch(p.name) and f"{SERIES}/{p.name}" not in listed:
+                p.unlink()
+    if entries:
+        atomic_write_text(out / "result.pvd", pvd_text(entries))
 
