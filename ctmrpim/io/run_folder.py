@@ -122,13 +122,16 @@ class RunFolder:
         self.path = Path(path)
         self.command, self.source, self.method, self.resume = command, source, method, resume
         self.created = False
+        self.previous: str | None = None     # --resume: the status record of the run it continues
         self.status: dict[str, Any] = {}
         self.t0 = time.perf_counter()
 
     def start(self) -> None:
-        """Check the folder, remove an earlier run's files (not what ``resume`` continues), write the status
-        record "running". A folder that cannot be written, or that holds files under a run's names that
-        ctmrpim did not write, is a ProblemError (key ``--out``) and is left as it was."""
+        """Check the folder, remove an earlier run's files, write the status record "running". A folder that
+        cannot be written, or that holds files under a run's names that ctmrpim did not write, is a
+        ProblemError (key ``--out``) and is left as it was. With ``resume`` nothing is removed here: the
+        explicit solver removes what the resumed run replaces once it has accepted the checkpoint, so that a
+        refused ``--resume`` leaves the folder as it found it."""
         out = self.path
         if out.exists() and not out.is_dir():
             raise ProblemError(f"cannot write the results to {str(out)!r} (it is a file, not a folder)", key="--out")
@@ -141,7 +144,10 @@ class RunFolder:
         try:
             self.created = not out.exists()
             out.mkdir(parents=True, exist_ok=True)
-            remove_outputs(out, self.resume)
+            if self.resume:
+                self.previous = (out / STATUS).read_text() if (out / STATUS).is_file() else None
+            else:
+                remove_outputs(out)
             self.status = {"program": PROGRAM, "version": __version__, "state": "running", "started": _now(),
                            "command": self.command, "cwd": os.getcwd(), "source": self.source, "method": self.method,
                            "resume": self.resume, "pid": os.getpid(), "host": socket.gethostname()}
@@ -170,7 +176,8 @@ class RunFolder:
         """Write the run's outputs (:func:`write_outputs`: result, series, summary last), then the status "ok";
         the paths written."""
         paths = write_outputs(result, case, self.path)
-        self.finish("ok", 0, outputs=paths)
+        # what the folder holds, not only what was written now: an explicit run wrote its series as it went
+        self.finish("ok", 0, outputs=[p for p in run_files(self.path) if not p.name.startswith(".")])
         return paths
 
     def not_converged(self, error: ConvergenceError, case: Case) -> Path:
@@ -186,12 +193,17 @@ class RunFolder:
 
     def discard(self) -> None:
         """Bad input found while solving: remove what this run wrote (and the folder, if it made it), so that
-        a refused run leaves nothing behind."""
+        a refused run leaves nothing behind; a refused ``--resume`` puts the status record back as it was."""
         if self.created:
             shutil.rmtree(self.path, ignore_errors=True)
-            return
-        remove_outputs(self.path, self.resume)
-        (self.path / STATUS).unlink(missing_ok=True)
+        elif self.resume:
+            if self.previous is None:
+                (self.path / STATUS).unlink(missing_ok=True)
+            else:
+                atomic_write_text(self.path / STATUS, self.previous)
+        else:
+            remove_outputs(self.path)
+            (self.path / STATUS).unlink(missing_ok=True)
 
 
 def write_outputs(result: Result, case: Case, out: Path) -> list[Path]:

@@ -298,3 +298,17 @@ def test_progress_in_a_log_waits_then_sums_a_loops_laps() -> None:
         Timer().lap("boundary")
         progress.current().status("step 1")    # within the interval after the last line: not written
     assert stream.getvalue().splitlines() == ["ctmrpim: [    0.0 s] boundary 0.00 s"]
+
+
+def test_a_refused_resume_leaves_the_folder_as_it_was(tmp_path, capsys) -> None:
+    """--resume with another setting: refused (exit 2), and the finished run it would have continued is
+    still whole, its status record included."""
+    out = tmp_path / "out"
+    sets = ["--set", "nodes.grid=[16,9]", "--set", "explicit.duration=0.02", "--set", "explicit.checkpoint_every=20"]
+    assert _run(capsys, "run", "column-collapse", *sets, "--out", str(out), "--quiet")[0] == 0
+    before = {p.relative_to(out): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+    code, _, stderr = _run(capsys, "run", "column-collapse", *sets, "--set", "material.phi=25", "--out", str(out),
+                           "--resume")
+    assert code == 2 and "belongs to another problem" in stderr
+    after = {p.relative_to(out): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+    assert after == before and _json(out / "status.json")["state"] == "ok"

@@ -257,13 +257,15 @@ def solve_explicit(case: Case, out: Path, resume: bool = False, progress: bool =
     run = ExplicitRun(case, out, input_key(case))
     with threadpool_limits(1):
         # until this run ends nothing looks complete, and no state of an earlier run stays (only files a run
-        # writes are removed; a resumed run keeps the checkpoint and series it continues)
+        # writes are removed; a resumed run keeps the checkpoint and series it continues, and removes nothing
+        # before its checkpoint is accepted)
         out.mkdir(parents=True, exist_ok=True)
-        remove_outputs(out, resume)
         if resume:
             run.resume()
+            remove_outputs(out, resume=True)
             _prune_series(out, run.series.entries)
         else:
+            remove_outputs(out)
             run.start()
         run.run(progress)
         return run.result()
