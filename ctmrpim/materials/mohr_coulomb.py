@@ -50,11 +50,13 @@ class MohrCoulomb:
     tension: float | None = None    # tension cut-off sigma_t (largest principal stress), None: none
 
     def __post_init__(self) -> None:
-        for key, ok in (("E", self.E > 0), ("nu", -1.0 < self.nu < 0.5), ("c", self.c >= 0),
-                        ("phi", 0.0 <= self.phi < 90.0), ("psi", 0.0 <= self.psi <= self.phi),
-                        ("density", self.density >= 0)):
+        for key, ok, allowed in (("E", self.E > 0, "> 0"), ("nu", -1.0 < self.nu < 0.5, "in (-1, 0.5)"),
+                                 ("c", self.c >= 0, ">= 0"), ("phi", 0.0 <= self.phi < 90.0, "in [0, 90) degrees"),
+                                 ("psi", 0.0 <= self.psi <= self.phi, f"in [0, phi] = [0, {self.phi:g}] degrees"),
+                                 ("density", self.density >= 0, ">= 0")):
             if not ok:
-                raise ProblemError(f"{getattr(self, key)!r} is out of range", key=f"material.{key}")
+                raise ProblemError(f"{getattr(self, key)!r} is out of range: it must be {allowed}",
+                                   key=f"material.{key}")
         if self.tension is not None and not self.tension >= 0:
             raise ProblemError(f"{self.tension!r} must be >= 0 (a tensile strength)", key="material.tension")
         if self.c == 0 and self.phi == 0:

@@ -160,10 +160,10 @@ class Loading:
         validate("loading", self, [
             ("until_failure", isinstance(self.until_failure, bool), "must be true or false"),
             ("tangent", self.tangent in ("consistent", "elastic"), "must be \"consistent\" or \"elastic\""),
-            ("steps", integer(self.steps, 1), "is out of range"),
-            ("tolerance", not isinstance(self.tolerance, bool) and 0 < self.tolerance < 1, "is out of range"),
-            ("max_iterations", integer(self.max_iterations, 1), "is out of range"),
-            ("max_cutbacks", integer(self.max_cutbacks, 0), "is out of range"),
+            ("steps", integer(self.steps, 1), "must be an integer >= 1"),
+            ("tolerance", not isinstance(self.tolerance, bool) and 0 < self.tolerance < 1, "must lie in (0, 1)"),
+            ("max_iterations", integer(self.max_iterations, 1), "must be an integer >= 1"),
+            ("max_cutbacks", integer(self.max_cutbacks, 0), "must be an integer >= 0"),
         ])
 
 

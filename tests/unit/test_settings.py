@@ -99,3 +99,16 @@ def test_consistent_integration_is_refused_where_it_is_not_implemented(target: s
 
     with pytest.raises(ProblemError, match=r"method\.integration"):
         ctmrpim.solve(benchmarks.load(target, change))
+
+
+def test_range_errors_give_the_range() -> None:
+    from ctmrpim.errors import ProblemError
+    from ctmrpim.materials.mohr_coulomb import MohrCoulomb
+    from ctmrpim.problem.settings import Loading
+
+    with pytest.raises(ProblemError, match=r"material.phi: 95.0 is out of range: it must be in \[0, 90\) degrees"):
+        MohrCoulomb(1e7, 0.3, 10.0, 95.0)
+    with pytest.raises(ProblemError, match=r"material.psi: 40.0 is out of range: it must be in \[0, phi\] = \[0, 30\]"):
+        MohrCoulomb(1e7, 0.3, 10.0, 30.0, 40.0)
+    with pytest.raises(ProblemError, match=r"loading.steps: 0 must be an integer >= 1"):
+        Loading(steps=0)
