@@ -163,6 +163,8 @@ def _title(case: Case, method: str) -> str:
 def cmd_run(args: argparse.Namespace) -> int:
     """``ctmrpim run TARGET``: solve a benchmark or problem file into its output folder, print a summary; exit
     status 0, or 3 when the solve did not converge (bad input raises a ProblemError: 2)."""
+    if args.out is not None and not args.out.strip():
+        raise ProblemError("--out '' names no folder: give a folder, or leave --out out for the default", key="--out")
     case = load_case(args.target, args.set or [])
     element = methods.element_of(methods.get(args.solver), args.element)
     suffix = "" if args.solver == methods.DEFAULT else f"-{args.solver}" + (f"-{element}" if element else "")
@@ -240,10 +242,6 @@ def main(argv: list[str] | None = None) -> int:
     args.argv = argv
     with warnings.catch_warnings():
         warnings.simplefilter("always", UserWarning)
-        # a relative error whose exact reference is zero is 0/0 or x/0 (ctmrpim/reference/error_norms.py):
-        # summary.json writes it as null with a note, so numpy's warning about it only alarms
-        warnings.filterwarnings("ignore", r"(divide by zero|invalid value) encountered", RuntimeWarning,
-                                r"ctmrpim\.reference\.error_norms")
         library_show = warnings.showwarning
 
         def show(message, category, *rest, **kw):

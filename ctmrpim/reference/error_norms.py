@@ -20,12 +20,18 @@ def relative_errors(problem: Problem, xq: np.ndarray, wq: np.ndarray, u_h: np.nd
     x, y = xq[:, 0], xq[:, 1]
     ue = exact.displacement(x, y)
     if ue is not None:
-        out["l2"] = float(np.sqrt(wq @ ((u_h - ue) ** 2).sum(1)) / np.sqrt(wq @ (ue ** 2).sum(1)))
+        out["l2"] = _ratio(np.sqrt(wq @ ((u_h - ue) ** 2).sum(1)), np.sqrt(wq @ (ue ** 2).sum(1)))
     se = exact.stress(x, y)
     if se is not None:
         C = np.linalg.inv(problem.D())
         de = stress_h - se
         num = wq @ np.einsum("pi,ij,pj->p", de, C, de)
         den = wq @ np.einsum("pi,ij,pj->p", se, C, se)
-        out["energy"] = float(np.sqrt(num / den))
+        out["energy"] = _ratio(np.sqrt(num), np.sqrt(den))
     return out
+
+
+def _ratio(num: float, den: float) -> float:
+    """num / den, NaN where the exact field is zero (a relative error is then undefined; summary.json writes
+    it as null with a note)."""
+    return float(num / den) if den > 0 else float("nan")

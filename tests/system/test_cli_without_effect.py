@@ -41,6 +41,7 @@ CASES = {
     "correction-with-ctm": Case(BASE + '[method]\nintegration = "ctm"\ncorrection = "linear"\n',
                                 ["method.correction", "read only by integration = \"ctm-vci\""]),
     "min-support-static": Case(BASE + "[method]\nmin_support = 12\n", ["method.min_support", "explicit dynamics"]),
+    "empty-out": Case(BASE, ["--out", "names no folder"], args=["--out", ""], names_file=False),
     "huge-grid": Case(edit("grid = [11, 3]", "grid = [100000, 100000]"),
                       ["nodes", "too large for this machine", "1e+10 nodes", "GiB of memory"]),
     "tiny-spacing": Case(edit("grid = [11, 3]", "spacing = 1e-5"), ["nodes", "too large for this machine"]),

@@ -206,7 +206,7 @@ def test_undefined_errors_are_null_with_a_note(tmp_path, capsys) -> None:
     assert code == 0 and stderr == ""
     s = _json(tmp_path / "out" / "summary.json")
     assert s["errors"]["energy"] is None and s["errors"]["l2"] < 1e-10
-    assert len(s["notes"]) == 1 and s["notes"][0].startswith("errors.energy is undefined (+infinity)")
+    assert len(s["notes"]) == 1 and s["notes"][0].startswith("errors.energy is undefined (NaN)")
     assert "energy undefined" in stdout
 
 
