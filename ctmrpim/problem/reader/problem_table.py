@@ -24,7 +24,7 @@ def read_problem_table(values: Values) -> ProblemTable:
     """The ``[problem]`` table; ``values`` records the defaults applied."""
     name = values.raw.get("problem", {})["name"]
     if not isinstance(name, str) or not name.strip() or any(c in name for c in "/\\"):
-        # the name is the default output folder runs/NAME: it must be one plain folder name
+        # a benchmark's default output folder is runs/NAME: the name must be one plain folder name
         raise ProblemError(f"name = {name!r} must be a non-empty string without / or \\", key="problem.name")
     analysis = values.get("problem", "analysis", "linear")
     if analysis not in ANALYSES:
