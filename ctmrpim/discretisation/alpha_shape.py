@@ -7,6 +7,9 @@ with the body on their left: outer loops counter-clockwise, holes clockwise, isl
 loops. Small spurious holes (a gap in a jittered cloud is not a hole) are filled, pinch vertices
 (where two parts of the body touch) are split so that every loop is simple, and the result is
 validated before anyone integrates over it.
+
+On a moving cloud the reference triangulation can be carried instead (:func:`carried_boundary`): it keeps
+the corners the body had, which the alpha shape of moved nodes cuts, for as long as it stays valid.
 """
 from __future__ import annotations
 
@@ -14,12 +17,16 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+import shapely
 from scipy.spatial import Delaunay, QhullError
 
 from ctmrpim.errors import ProblemError
 
 #: Holes with an area below this many d_c^2 are gaps in the cloud, not holes, and are filled.
 SPURIOUS_HOLE_AREA = 4.0
+#: A carried triangle squashed below this share of its reference area ends the carried topology (the alpha
+#: shape re-tracks): the body there no longer looks like the reference
+MIN_CARRIED_AREA = 0.05
 
 
 @dataclass
@@ -127,6 +134,37 @@ def alpha_shape(points: np.ndarray, alpha: float, d_c: float, reference: np.ndar
                         filled_holes=filled)
     validate(boundary)
     return boundary
+
+
+def carried_boundary(points: np.ndarray, triangles: np.ndarray, reference: np.ndarray) -> Boundary | None:
+    """The boundary of the reference triangulation ``triangles`` (t, 3; counter-clockwise on the ``reference``
+    positions (n, 2)) carried to the moved nodes ``points`` (n, 2), while it stays valid: every triangle still
+    counter-clockwise with at least MIN_CARRIED_AREA of its reference area, and the boundary loops simple and
+    apart. It keeps the corners the body carries (a re-entrant corner node stays a boundary vertex), which the
+    alpha shape of the moved nodes cuts with a triangle across the notch; None where a triangle folded or
+    flattened or two parts of the boundary touch (then the alpha shape re-tracks)."""
+    now, ref = _doubled_areas(points, triangles), _doubled_areas(reference, triangles)
+    if not np.all(now > MIN_CARRIED_AREA * ref):
+        return None
+    loops = _loops(points, triangles)
+    rings = shapely.multilinestrings([points[np.r_[lp, lp[:1]]] for lp in loops])
+    if not shapely.is_simple(rings):
+        return None
+    used = np.zeros(len(points), bool)
+    used[triangles.ravel()] = True
+    boundary = Boundary(points=points, loops=loops, triangles=triangles, detached=np.flatnonzero(~used),
+                        filled_holes=0)
+    try:
+        validate(boundary)
+    except ProblemError:
+        return None
+    return boundary
+
+
+def _doubled_areas(points: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """(t,) twice the signed area of each triangle (positive counter-clockwise)."""
+    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
+    return (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
 
 
 def _inside(q: np.ndarray, poly: np.ndarray) -> np.ndarray:

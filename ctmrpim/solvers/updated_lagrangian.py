@@ -1,7 +1,8 @@
 """Adaptive updated-Lagrangian CTM-RPIM, quasi-static (paper Sections 2.1.2-2.1.3, 3.2).
 
 The paper's adaptive method: after every converged load increment the field nodes have moved, and
-the alpha shape re-tracks the boundary on the current node positions, the CTM lines and their
+the boundary is re-tracked on the current node positions (the reference triangulation carried while it
+stays valid, so corners are kept; the alpha shape once it is not: :func:`carried_boundary`), the CTM lines and their
 integration points are laid over the new boundary and the RPIM shape functions are rebuilt there.
 No mesh exists, so none distorts.
 
@@ -39,7 +40,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from ctmrpim.discretisation import assembly
-from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape
+from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape, carried_boundary
 from ctmrpim.discretisation.boundary_loads import BoundaryLoads
 from ctmrpim.discretisation.configuration import BoundaryTags, boundary_tags, build, lay_points, reference_cloud
 from ctmrpim.discretisation.rpim import ShapeFunctions
@@ -111,9 +112,12 @@ class AdaptiveBody:
 
     def __init__(self, case: Case, X: np.ndarray, lengths: ScaledMethod,
                  update: HypoelasticUpdate | LeftCauchyGreenUpdate, traction: TractionTags,
-                 material_points: np.ndarray, point_forces: np.ndarray, timer: Timer) -> None:
+                 material_points: np.ndarray, point_forces: np.ndarray, timer: Timer,
+                 reference_triangles: np.ndarray) -> None:
         self.case, self.X, self.lengths, self.update, self.traction, self.timer = (case, X, lengths, update, traction,
                                                                                  timer)
+        self.reference_triangles = reference_triangles   # the reference boundary's (corners kept)
+        self.tracking = [0, 0]                           # boundaries tracked: carried topology, alpha shape
         self.x = X.copy()
         self.U = np.zeros(X.size)                    # total displacement, interleaved
         self.far = REFERENCE_NEIGHBOURS * lengths.support_radius
@@ -133,8 +137,12 @@ class AdaptiveBody:
 
     # -- configuration -------------------------------------------------------------------------------
     def _track(self) -> tuple[Boundary, float]:
-        boundary = alpha_shape(self.x, self.lengths.alpha, self.lengths.d_c, reference=self.X,
-                               max_reference_edge=REFERENCE_NEIGHBOURS * self.lengths.alpha)
+        # the reference triangulation, carried, keeps the corners; the alpha shape once it is no longer valid
+        boundary = carried_boundary(self.x, self.reference_triangles, self.X)
+        self.tracking[boundary is None] += 1
+        if boundary is None:
+            boundary = alpha_shape(self.x, self.lengths.alpha, self.lengths.d_c, reference=self.X,
+                                   max_reference_edge=REFERENCE_NEIGHBOURS * self.lengths.alpha)
         if len(boundary.detached):
             i = boundary.detached[0]
             raise ProblemError(f"{len(boundary.detached)} node(s) left the alpha shape after rebuild {self.rebuilds}, "
@@ -298,17 +306,24 @@ class AdaptiveBody:
         return self.U.reshape(-1, 2).copy()
 
     def stress_nodes(self) -> np.ndarray:
-        """(n, 3) Cauchy stress sxx, syy, sxy at the nodes, of the state projected to them."""
-        return self.update.cauchy(self.nodal_state)
+        """(n, 3) Cauchy stress sxx, syy, sxy at the nodes (:meth:`_nodal_stress`)."""
+        return self._nodal_stress()[:, :3]
 
     def stress_zz_nodes(self) -> np.ndarray:
         """(n,) out-of-plane Cauchy stress szz at the nodes: the rate law's state holds it; neo-Hookean (plane
         strain, F33 = 1) has szz = lambda ln J / J with J = sqrt(det b)."""
-        state = self.nodal_state
+        return self._nodal_stress()[:, 3]
+
+    def _nodal_stress(self) -> np.ndarray:
+        """(n, 4) sxx, syy, sxy, szz at the nodes. The rate law's state is the stress: its projection. For
+        neo-Hookean the stress is computed at the points and then projected: the projection of b itself can
+        lose positive definiteness at a boundary node (det b < 0 gave NaN stresses in series steps)."""
         if isinstance(self.update, HypoelasticUpdate):
-            return state[:, 3].copy()
-        J = np.sqrt(state[:, 0] * state[:, 1] - state[:, 2] ** 2)
-        return self.update.material.lam * np.log(J) / J
+            return np.asarray(self.nodal_state[:, :4], float).copy()
+        b = self.state
+        J = np.sqrt(b[:, 0] * b[:, 1] - b[:, 2] ** 2)
+        at_points = np.c_[self.update.cauchy(b), self.update.material.lam * np.log(J) / J]
+        return project_to_nodes(self.sf.N, self.w, at_points)
 
     def step_output(self) -> dict[str, np.ndarray]:
         """A series step's nodal output on the current configuration: ``u``, ``stress``, ``stress_zz``, the tracked
@@ -341,7 +356,7 @@ def adaptive_body(case: Case, timer: Timer | None = None) -> tuple[AdaptiveBody,
     loads_X = np.array([[p.x, p.y] for p in problem.point_loads]).reshape(-1, 2)
     forces = np.array([[p.fx, p.fy] for p in problem.point_loads]).reshape(-1, 2)
     body = AdaptiveBody(case, cloud.nodes, cloud.lengths, update, _traction_tags(cloud.nodes, tags, problem.thickness),
-                        np.r_[probes_X, loads_X], forces, timer)
+                        np.r_[probes_X, loads_X], forces, timer, cloud.boundary.triangles)
     return body, tags
 
 
@@ -396,6 +411,7 @@ def solve_updated_lagrangian(case: Case) -> Result:
                 "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
                 "rebuilds": body.rebuilds, "state_transfers": body.transfers,
                 "rebuilds_skipped": body.skipped_rebuilds,
+                "boundaries_tracked": {"carried": body.tracking[0], "alpha_shape": body.tracking[1]},
                 "boundary_loops": len(body.boundary.loops),
                 "tracked_area": {"initial": float(areas[0]), "final": float(areas[-1]),
                                  "largest_step_change": float(np.abs(np.diff(areas) / areas[:-1]).max())
