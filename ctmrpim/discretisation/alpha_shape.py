@@ -136,15 +136,17 @@ def alpha_shape(points: np.ndarray, alpha: float, d_c: float, reference: np.ndar
     return boundary
 
 
-def carried_boundary(points: np.ndarray, triangles: np.ndarray, reference: np.ndarray) -> Boundary | None:
+def carried_boundary(points: np.ndarray, triangles: np.ndarray, reference: np.ndarray,
+                     alpha: float) -> Boundary | None:
     """The boundary of the reference triangulation ``triangles`` (t, 3; counter-clockwise on the ``reference``
     positions (n, 2)) carried to the moved nodes ``points`` (n, 2), while it stays valid: every triangle still
-    counter-clockwise with at least MIN_CARRIED_AREA of its reference area, and the boundary loops simple and
-    apart. It keeps the corners the body carries (a re-entrant corner node stays a boundary vertex), which the
-    alpha shape of the moved nodes cuts with a triangle across the notch; None where a triangle folded or
-    flattened or two parts of the boundary touch (then the alpha shape re-tracks)."""
+    counter-clockwise with at least MIN_CARRIED_AREA of its reference area and a circumradius below ``alpha``
+    (what the alpha shape would keep: a node thrown off the body stretches its triangles beyond it), and the
+    boundary loops simple and apart. It keeps the corners the body carries (a re-entrant corner node stays a
+    boundary vertex), which the alpha shape of the moved nodes cuts with a triangle across the notch; None where
+    a triangle folded, flattened or stretched or two parts of the boundary touch (the alpha shape re-tracks)."""
     now, ref = _doubled_areas(points, triangles), _doubled_areas(reference, triangles)
-    if not np.all(now > MIN_CARRIED_AREA * ref):
+    if not np.all(now > MIN_CARRIED_AREA * ref) or not np.all(circumradii(points, triangles) < alpha):
         return None
     loops = _loops(points, triangles)
     rings = shapely.multilinestrings([points[np.r_[lp, lp[:1]]] for lp in loops])

@@ -138,7 +138,7 @@ class AdaptiveBody:
     # -- configuration -------------------------------------------------------------------------------
     def _track(self) -> tuple[Boundary, float]:
         # the reference triangulation, carried, keeps the corners; the alpha shape once it is no longer valid
-        boundary = carried_boundary(self.x, self.reference_triangles, self.X)
+        boundary = carried_boundary(self.x, self.reference_triangles, self.X, self.lengths.alpha)
         self.tracking[boundary is None] += 1
         if boundary is None:
             boundary = alpha_shape(self.x, self.lengths.alpha, self.lengths.d_c, reference=self.X,

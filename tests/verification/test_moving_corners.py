@@ -60,7 +60,7 @@ def test_alpha_shape_of_the_turned_cloud_cuts_the_corner_the_carried_one_keeps()
     X = cloud.nodes
     c, s = np.cos(np.pi / 3), np.sin(np.pi / 3)
     x = X @ np.array([[c, s], [-s, c]])                          # turned by 60 degrees
-    carried = carried_boundary(x, cloud.boundary.triangles, X)
+    carried = carried_boundary(x, cloud.boundary.triangles, X, cloud.lengths.alpha)
     alpha = alpha_shape(x, cloud.lengths.alpha, cloud.d_c)
     corner = int(np.argmin(np.hypot(X[:, 0] - 1, X[:, 1] - 1)))
     assert carried is not None and corner in set(carried.edges.ravel().tolist())
@@ -73,5 +73,23 @@ def test_a_folded_triangulation_is_not_carried() -> None:
     tri = np.array([[0, 1, 3], [0, 3, 2]])
     x = X.copy()
     x[3] = [-0.5, -0.5]                                           # node 3 pushed through the opposite edge
-    assert carried_boundary(X, tri, X) is not None
-    assert carried_boundary(x, tri, X) is None
+    assert carried_boundary(X, tri, X, 2.0) is not None
+    assert carried_boundary(x, tri, X, 2.0) is None
+
+
+def test_the_explicit_solver_keeps_a_stepped_columns_corner(tmp_path) -> None:
+    """The explicit solver's first frame and its re-layings carry the reference triangulation while valid: a
+    stepped column (an L of granular material against the walls) keeps its re-entrant corner, which the alpha
+    shape of the same nodes cuts."""
+    from ctmrpim import benchmarks
+    from ctmrpim.solvers.explicit.run import ExplicitRun
+
+    step = 'geometry.add=[{polygon = [[0, 0], [0.2, 0], [0.2, 0.05], [0.1, 0.05], [0.1, 0.1], [0, 0.1]]}]'
+    run = ExplicitRun(benchmarks.load("column-collapse", ["nodes.grid=[21, 11]", step]), tmp_path, "key")
+    run.dropped_points = 0
+    frame = run.lay_frame(run.X, np.zeros(len(run.X), bool))
+    corner = int(np.argmin(np.hypot(run.X[:, 0] - 0.1, run.X[:, 1] - 0.05)))
+    assert corner in set(frame.boundary.edges.ravel().tolist())
+    assert frame.boundary.area == pytest.approx(0.015, rel=1e-12) and run.tracking == [1, 0]
+    alpha = alpha_shape(run.X, run.lengths.alpha, run.d_c)
+    assert corner not in set(alpha.edges.ravel().tolist()) and alpha.area > 0.015

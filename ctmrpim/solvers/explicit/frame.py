@@ -1,6 +1,7 @@
 """The frame of the explicit solver: the configuration its points are built on (Section 2.1.4).
 
-**Configuration.** Boundary (alpha shape), CTM points and RPIM shape functions are built on the node
+**Configuration.** Boundary (the reference triangulation carried while valid, so corners are kept, else the
+alpha shape), CTM points and RPIM shape functions are built on the node
 positions x_r of the last rebuild (the frame, a
 :class:`~ctmrpim.discretisation.configuration.Configuration`). Between rebuilds the points move with the body:
 the deformation gradient relative to x_r is F = I + grad_r (x - x_r), and
@@ -24,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape
+from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape, carried_boundary
 from ctmrpim.discretisation.configuration import Configuration, build, lay_points
 from ctmrpim.discretisation.state_transfer import NodalProjection
 from ctmrpim.solvers.explicit.errors import Diverged
@@ -39,7 +40,8 @@ IDENTITY = np.array([1.0, 0.0, 0.0, 1.0])
 
 class FrameBuilder:
     """Builds the frames of an :class:`~ctmrpim.solvers.explicit.run.ExplicitRun` (a mixin of it: reads the
-    run's ``case``, ``settings``, ``lengths``, ``d_c`` and ``thickness``, counts into ``dropped_points``)."""
+    run's ``case``, ``settings``, ``lengths``, ``d_c``, ``thickness``, reference nodes ``X`` and
+    ``reference_triangles``, counts into ``dropped_points`` and ``tracking``)."""
 
     def lay_frame(self, x: np.ndarray, free: np.ndarray) -> Configuration:
         """Boundary and new CTM points on positions x (n, 2) of the body's nodes (``free`` (n,) marks the
@@ -47,6 +49,14 @@ class FrameBuilder:
         stops naming it; with ``"free"`` it becomes a free particle for good (gravity and the walls move
         it, it keeps its mass, no stress): a grain that left the flow does not rejoin it, so it can never
         land on top of a node of the body (two nodes at one place make the RPIM moment matrix singular)."""
+        # the reference triangulation, carried, keeps the body's corners while it is valid and touches no node
+        # that has left the body (alpha_shape.carried_boundary); the alpha shape re-tracks once it is not
+        tri = self.reference_triangles
+        carried = None if free[tri].any() else carried_boundary(x, tri, self.X, self.lengths.alpha)
+        self.tracking[carried is None] += 1
+        if carried is not None:
+            quad, w = lay_points([x[lp] for lp in carried.loops], self.lengths, self.thickness)
+            return self.frame_at(x, free, quad.points, w, carried.loops, carried.triangles)
         body = np.flatnonzero(~free)
         sub = alpha_shape(x[body], self.lengths.alpha, self.d_c)
         detached = body[sub.detached]

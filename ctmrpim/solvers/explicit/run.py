@@ -103,6 +103,8 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
         n = len(self.X)
         self.thickness = problem.thickness
         self.mass = lumped_mass(self.X, cloud.boundary.triangles, self.material.density, self.thickness)
+        self.reference_triangles = cloud.boundary.triangles      # corners kept: carried while valid
+        self.tracking = [0, 0]                                   # boundaries tracked: carried, alpha shape
         self.weight = self.mass[:, None] * np.asarray(problem.gravity, float)[None, :]
         boundary_nodes = np.unique(np.concatenate(cloud.boundary.loops))
         tol = self.lengths.match_tolerance
@@ -215,6 +217,7 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
             "dt": {"first": self.history[0]["dt"] if self.history else self.dt, "min": self.dt_range[0],
                    "max": self.dt_range[1], "wave_speed_bound": self.dt_wave, "setting": self.settings.dt},
             "rebuilds": self.rebuilds, "state_transfers": self.transfers, "returned_to_yield": self.returned,
+            "boundaries_tracked": {"carried": self.tracking[0], "alpha_shape": self.tracking[1]},
             "re_tracking_failed": {"count": self.relay_failures, "first": self.relay_failure},
             "free_particles": {"final": len(self.x) - len(self.frame.active), "most": self.free_max,
                                "policy": self.settings.detached},

@@ -104,7 +104,7 @@ class RunState:
                 "rebuilds": self.rebuilds, "transfers": self.transfers, "returned": self.returned, "areas": self.areas,
                 "area_changes": self.area_changes,
                 "free_max": self.free_max, "relay_failures": self.relay_failures,
-                "relay_failure": self.relay_failure, "dropped_points": self.dropped_points,
+                "relay_failure": self.relay_failure, "dropped_points": self.dropped_points, "tracking": self.tracking,
                 "energy": asdict(self.energy), "ke_peak": self.ke_peak, "stage_residual": self.stage_residual,
                 "history": self.history, "series": self.series.entries, "next_save": self.next_save,
                 "next_record": self.next_record}
@@ -125,7 +125,7 @@ class RunState:
         self.laid = a["laid"]
         for k in ("stage", "t", "step", "stage_steps", "dt", "omega", "dt_range", "dt_wave", "rebuilds", "transfers",
                   "returned", "areas", "area_changes", "free_max", "relay_failures", "relay_failure",
-                  "dropped_points", "ke_peak", "stage_residual",
+                  "dropped_points", "tracking", "ke_peak", "stage_residual",
                   "history", "next_save", "next_record"):
             setattr(self, k, meta[k])
         self.energy = Energy(**meta["energy"])
