@@ -27,10 +27,13 @@ written as the traction of the discrete solution, t = sigma(u_h) n: :func:`diric
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import scipy.sparse as sp
 
 from ctmrpim.discretisation.ctm import BoundaryQuadrature, boundary_points
+from ctmrpim.discretisation.lagrangian_operators import gradient_operator, value_operator
 from ctmrpim.discretisation.rpim import ShapeFunctions
 
 #: Gauss points per boundary segment, for the correction and the tractions alike (mixing 2 and 3 points
@@ -118,3 +121,42 @@ def dirichlet_consistency(n_nodes: int, fixed: np.ndarray, boundary: BoundaryQua
             block = (NtW @ (sp.diags(a[on]) @ A[on] + sp.diags(b[on]) @ B[on])).tocoo()
             C = C + sp.csr_matrix((block.data, (2 * block.row + k, 2 * block.col + l)), shape=C.shape)
     return C.tocsr()
+
+
+class LagrangianDirichletTerm:
+    """The Dirichlet consistency term of a total-Lagrangian (hyperelastic) solve with ``ctm-vci``: the large-
+    deformation form of :func:`dirichlet_consistency`, subtracted from the internal force,
+
+        f_(I, k) -= sum_b w_b N_I(x_b) t_k(x_b),   t = P(F) N   (first Piola-Kirchhoff traction, reference normal N)
+
+    over the ``boundary`` Gauss points of segments whose two end nodes have component k prescribed (``fixed``,
+    interleaved dofs), F = I + grad_X u at the points from the (uncorrected) shape functions ``sf``; with its
+    derivative dt_k/du = (A : grad N) N, A = dP/dF, subtracted from the tangent. A hyperelastic material has no
+    history, so the traction at a boundary point is its own, computed from F there."""
+
+    def __init__(self, n_nodes: int, fixed: np.ndarray, boundary: BoundaryQuadrature, sf: ShapeFunctions,
+                 thickness: float) -> None:
+        prescribed = np.zeros(2 * n_nodes, bool)
+        prescribed[fixed] = True
+        ends = boundary.ends
+        on = np.stack([prescribed[2 * ends[:, 0] + k] & prescribed[2 * ends[:, 1] + k] for k in (0, 1)], axis=1)
+        self.active = bool(on.any())
+        self.normals = boundary.normals
+        rows, cols = np.nonzero(on)
+        b = len(boundary.weights)
+        # W (2b x 2b): w_b on the rows (b, k) with component k prescribed; S = N^T W maps tractions to forces
+        W = sp.csr_matrix((boundary.weights[rows] * thickness, (2 * rows + cols, 2 * rows + cols)), shape=(2 * b, 2 * b))
+        self.S = (value_operator(sf.N).T @ W).tocsr()
+        self.G = gradient_operator(sf.dNdx, sf.dNdy)
+
+    def __call__(self, U: np.ndarray, stress_tangent: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+                 ) -> tuple[np.ndarray, sp.csr_matrix]:
+        """The term's force (2n,) and tangent (2n x 2n) at displacements ``U``; ``stress_tangent(F)`` gives P
+        (b, 2, 2) and A (b, 2, 2, 2, 2) at deformation gradients F (b, 2, 2)."""
+        F = np.eye(2)[None] + (self.G @ U).reshape(-1, 2, 2)
+        P, A = stress_tangent(F)
+        t = np.einsum("biJ,bJ->bi", P, self.normals)
+        T = np.einsum("biJkL,bJ->bikL", A, self.normals).reshape(-1, 2, 4)   # dt_i / dF_kL
+        b = len(T)
+        Tm = sp.bsr_matrix((T, np.arange(b), np.arange(b + 1)), shape=(2 * b, 4 * b))
+        return self.S @ t.ravel(), (self.S @ (Tm @ self.G)).tocsr()

@@ -23,9 +23,13 @@ from ctmrpim.run_options import RunOptions
 def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Result:
     """Solve ``case`` with CTM-RPIM (``element`` is always None: the method has none)."""
     analysis = case.problem.analysis
-    if case.method.integration != "ctm" and analysis != "linear":
-        raise ProblemError(f"method.integration = {case.method.integration!r} is implemented for linear analyses; "
-                           f"a {analysis!r} analysis integrates with \"ctm\"", key="method.integration")
+    scheme = case.method.integration
+    total_lagrangian = (analysis == "quasi-static" and case.method.formulation == "total-lagrangian"
+                        and not isinstance(case.problem.material, MohrCoulomb))
+    if scheme != "ctm" and analysis != "linear" and not (scheme == "ctm-vci" and total_lagrangian):
+        raise ProblemError(f"method.integration = {scheme!r} is implemented for linear analyses"
+                           + (" and (ctm-vci) the total-Lagrangian formulation" if scheme == "ctm-vci" else "")
+                           + f"; this {analysis!r} analysis integrates with \"ctm\"", key="method.integration")
     if analysis == "explicit":
         from ctmrpim.solvers.explicit.run import solve_explicit
         if options.out is None:

@@ -15,8 +15,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ctmrpim.discretisation import consistent_integration
 from ctmrpim.discretisation.boundary_loads import reference_loads
-from ctmrpim.discretisation.configuration import boundary_tags, reference_configuration
+from ctmrpim.discretisation.configuration import BoundaryTags, Configuration, boundary_tags, reference_configuration
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.neo_hookean import NeoHookean
@@ -36,6 +37,23 @@ def _cauchy(material: NeoHookean, G: sp.csr_matrix, U: np.ndarray) -> np.ndarray
     J = np.linalg.det(F)
     sig = P @ F.transpose(0, 2, 1) / J[:, None, None]
     return np.c_[sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1], material.lam * np.log(J) / J]
+
+
+def _consistent(case: Case, conf: Configuration, tags: BoundaryTags
+                ) -> tuple[sp.bsr_matrix, consistent_integration.LagrangianDirichletTerm]:
+    """``method.integration = "ctm-vci"`` on the reference configuration: G~^T of the corrected test gradients
+    (the integration constraints hold against the boundary's Gauss points) and the Dirichlet consistency term
+    (:mod:`ctmrpim.discretisation.consistent_integration`); K = G~^T diag(w A) G is Petrov-Galerkin."""
+    if case.method.boundary != "alpha":
+        raise ProblemError("method.integration = \"ctm-vci\" integrates over the node loops of the tracked boundary: "
+                           "set method.boundary = \"alpha\"", key="method.integration")
+    boundary = consistent_integration.boundary_quadrature(conf.x, conf.boundary.edges)
+    sf_b = conf.shape_functions_at(boundary.points)
+    thickness = case.problem.thickness
+    test_dx, test_dy = consistent_integration.corrected_gradients(
+        conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf, boundary, sf_b.N, case.method.correction)
+    term = consistent_integration.LagrangianDirichletTerm(len(conf.x), tags.fixed, boundary, sf_b, thickness)
+    return gradient_operator(test_dx, test_dy).T.tobsr(), term
 
 
 def solve_total_lagrangian(case: Case) -> Result:
@@ -61,6 +79,9 @@ def solve_total_lagrangian(case: Case) -> Result:
     timer.lap("shape_functions")
     G = conf.block_gradient()
     GT = G.T
+    dirichlet = None
+    if method.integration == "ctm-vci":   # corrected test gradients, and the traction of u_h on constrained edges
+        GT, dirichlet = _consistent(case, conf, tags)
     follower = tags.traction.follower
     loads = reference_loads(conf, tags, problem.thickness, conf.point_forces(problem))
 
@@ -75,10 +96,14 @@ def solve_total_lagrangian(case: Case) -> Result:
         f_ext, K_load = loads.forces(nodes + U.reshape(-1, 2), factor)
         P, A = material.stress_tangent(np.eye(2)[None] + (G @ U).reshape(-1, 2, 2))
         K = tangent(G, A, w, GT)
-        return f_ext, internal_force(G, P, w, GT), (K if K_load is None else K + K_load)
+        f_int = internal_force(G, P, w, GT)
+        if dirichlet is not None and dirichlet.active:
+            f_d, K_d = dirichlet(U, material.stress_tangent)
+            f_int, K = f_int - f_d, K - K_d
+        return f_ext, f_int, (K if K_load is None else K + K_load)
 
-    # follower loads make the tangent non-symmetric: no Cholesky then
-    linear_solver = "superlu" if follower.any() else method.solver
+    # follower loads and the consistent scheme make the tangent non-symmetric: no Cholesky then
+    linear_solver = "superlu" if follower.any() or dirichlet is not None else method.solver
 
     def solve(K, residual):
         return solve_constrained(K, residual, fixed, np.zeros(len(fixed)), linear_solver)
