@@ -146,7 +146,9 @@ class LagrangianDirichletTerm:
         b = len(boundary.weights)
         # W (2b x 2b): w_b on the rows (b, k) with component k prescribed; S = N^T W maps tractions to forces
         W = sp.csr_matrix((boundary.weights[rows] * thickness, (2 * rows + cols, 2 * rows + cols)), shape=(2 * b, 2 * b))
-        self.S = (value_operator(sf.N).T @ W).tocsr()
+        # rows of prescribed dofs dropped: their equations are replaced by the prescribed values, and the internal
+        # force there stays the reaction (the Newton iteration measures its residual against it)
+        self.S = (sp.diags((~prescribed).astype(float)) @ value_operator(sf.N).T @ W).tocsr()
         self.G = gradient_operator(sf.dNdx, sf.dNdy)
 
     def __call__(self, U: np.ndarray, stress_tangent: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
@@ -160,3 +162,46 @@ class LagrangianDirichletTerm:
         b = len(T)
         Tm = sp.bsr_matrix((T, np.arange(b), np.arange(b + 1)), shape=(2 * b, 4 * b))
         return self.S @ t.ravel(), (self.S @ (Tm @ self.G)).tocsr()
+
+
+class RecoveredDirichletTerm:
+    """The Dirichlet consistency term of a small-strain, history-dependent (elastoplastic) solve with
+    ``ctm-vci``: the stress at a boundary Gauss point is not a state anyone keeps, so it is the stress recovered
+    there from the integration points' (:func:`ctmrpim.discretisation.stress_recovery.recovery_operator`, R):
+
+        f_(I, k) -= sum_b w_b N_I(x_b) t_k(x_b),   t = (R sigma)(x_b) n,
+
+    over the ``boundary`` points of segments whose two end nodes have component k prescribed (``fixed``), and
+    in the tangent its derivative through the points' tangents, (S N R) diag(A) G. Exact for a constant stress,
+    so the patch test holds; the recovery is linear, so the tangent is consistent."""
+
+    def __init__(self, n_nodes: int, fixed: np.ndarray, boundary: BoundaryQuadrature, N_boundary: sp.csr_matrix,
+                 recovery: sp.csr_matrix, thickness: float) -> None:
+        prescribed = np.zeros(2 * n_nodes, bool)
+        prescribed[fixed] = True
+        ends = boundary.ends
+        on = np.stack([prescribed[2 * ends[:, 0] + k] & prescribed[2 * ends[:, 1] + k] for k in (0, 1)], axis=1)
+        rows, cols = np.nonzero(on)
+        b = len(boundary.weights)
+        W = sp.csr_matrix((boundary.weights[rows] * thickness, (2 * rows + cols, 2 * rows + cols)), shape=(2 * b, 2 * b))
+        nx, ny = boundary.normals[:, 0], boundary.normals[:, 1]
+        # t_x = s_xX n_x + s_xY n_y, t_y = s_yX n_x + s_yY n_y on the stress layout xX, xY, yX, yY
+        blocks = np.zeros((b, 2, 4))
+        blocks[:, 0, 0], blocks[:, 0, 1], blocks[:, 1, 2], blocks[:, 1, 3] = nx, ny, nx, ny
+        Nn = sp.bsr_matrix((blocks, np.arange(b), np.arange(b + 1)), shape=(2 * b, 4 * b))
+        R4 = sp.kron(recovery, sp.identity(4), format="csr")
+        self.active = bool(on.any())
+        # (2n x 4m): stresses -> forces; rows of prescribed dofs dropped, as in LagrangianDirichletTerm
+        self.operator = (sp.diags((~prescribed).astype(float)) @ value_operator(N_boundary).T @ W @ Nn @ R4).tocsc()
+
+    def force(self, P: np.ndarray) -> np.ndarray:
+        """(2n,) the term's force of the stresses P (m, 4: xX, xY, yX, yY) at the integration points."""
+        return self.operator @ P.ravel()
+
+    def stiffness(self, G: sp.bsr_matrix, A: np.ndarray, points: np.ndarray | None = None) -> sp.csr_matrix:
+        """(2n x 2n) its derivative: operator diag(A) G over the rows of G, the tangents A (k, 4, 4) of the k
+        ``points`` those rows belong to (all points where None)."""
+        k = len(A)
+        op = self.operator if points is None else self.operator[:, (4 * points[:, None] + np.arange(4)).ravel()]
+        blocks = sp.bsr_matrix((A, np.arange(k), np.arange(k + 1)), shape=(4 * k, 4 * k))
+        return (op @ (blocks @ G)).tocsr()

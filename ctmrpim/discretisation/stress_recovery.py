@@ -22,6 +22,7 @@ a linear fit over 1.5 d_c 3091 at 0.125, over 2.5 d_c 2869 at 0.25).
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from ctmrpim.errors import ProblemError
@@ -47,6 +48,15 @@ def recovered_stress(at: np.ndarray, points: np.ndarray, weights: np.ndarray, st
     """The recovered stress (k, c) at the k points ``at`` (k, 2) from the stresses ``stress`` (m, c) at the
     integration ``points`` (m, 2) with area ``weights`` (m,): the moving least-squares fit above, radius
     ``radius`` d_c or more (``POINTS_PER_TERM``). Fewer integration points than that in all is an error."""
+    return np.asarray(recovery_operator(at, points, weights, d_c, radius, order) @ stress)
+
+
+def recovery_operator(at: np.ndarray, points: np.ndarray, weights: np.ndarray, d_c: float,
+                      radius: float = RADIUS, order: int = ORDER) -> sp.csr_matrix:
+    """R (k x m), the recovery as a linear map: the recovered value at ``at`` (k, 2) of any field given at the
+    integration ``points`` (m, 2) with area ``weights`` (m,) is R @ values (:func:`recovered_stress`). A consistent
+    scheme's Dirichlet term differentiates through it (the traction of a history-dependent stress at a boundary
+    point is the recovered stress there)."""
     t = (order + 1) * (order + 2) // 2            # terms of the complete polynomial (_basis)
     need = POINTS_PER_TERM * t
     if len(points) < need:
@@ -66,6 +76,7 @@ def recovered_stress(at: np.ndarray, points: np.ndarray, weights: np.ndarray, st
     for a in range(t):
         for b in range(a, t):
             M[:, a, b] = M[:, b, a] = np.bincount(i, kernel * P[:, a] * P[:, b], k)
-    R = np.stack([np.stack([np.bincount(i, kernel * P[:, a] * stress[p, c], k) for c in range(stress.shape[1])],
-                           axis=1) for a in range(t)], axis=1)
-    return np.linalg.solve(M, R)[:, 0, :]
+    # the fitted polynomial's value at the evaluation point is its constant term: row 0 of M^-1 applied to
+    # sum_p kernel P(x_p) sigma_p, so each pair's weight is kernel (M^-1)[0] . P(x_p)
+    first = np.linalg.solve(M, np.broadcast_to(np.eye(t)[0], (k, t))[..., None])[..., 0]   # M symmetric
+    return sp.csr_matrix((kernel * np.einsum("ea,ea->e", first[i], P), (i, p)), shape=(k, len(points)))

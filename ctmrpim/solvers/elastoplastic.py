@@ -10,12 +10,15 @@ from __future__ import annotations
 from typing import Any, Callable
 
 import numpy as np
+import scipy.sparse as sp
 
-from ctmrpim.discretisation import assembly
+from ctmrpim.discretisation import assembly, consistent_integration
 from ctmrpim.discretisation.boundary_loads import reference_loads
 from ctmrpim.discretisation.configuration import BoundaryTags, Configuration, boundary_tags, reference_configuration
+from ctmrpim.discretisation.lagrangian_operators import gradient_operator
 from ctmrpim.discretisation.nodal_average import RADIUS, KernelAverage
 from ctmrpim.discretisation.state_transfer import NodalProjection
+from ctmrpim.discretisation.stress_recovery import recovery_operator
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.problem.case import Case
@@ -36,11 +39,29 @@ def ctm_plastic_system(case: Case, timer: Timer) -> tuple[PlasticSystem, Configu
     conf = reference_configuration(case, timer)
     tags = boundary_tags(case, conf.x, conf.boundary, conf.lengths)
     loads = reference_loads(conf, tags, problem.thickness, conf.point_forces(problem))
+    test, dirichlet = _consistent(case, conf, tags) if case.method.integration == "ctm-vci" else (None, None)
     system = PlasticSystem(conf.block_gradient(), conf.w, tags.fixed, tags.fixed_values,
                            lambda factor: loads.forces(conf.x, factor)[0],
                            assembly.body_force_vector(conf.N, conf.w, problem), problem.material,
-                           tangent=case.loading.tangent)
+                           tangent=case.loading.tangent, test=test, dirichlet=dirichlet)
     return system, conf, tags
+
+
+def _consistent(case: Case, conf: Configuration, tags: BoundaryTags
+                ) -> tuple[sp.bsr_matrix, consistent_integration.RecoveredDirichletTerm]:
+    """``method.integration = "ctm-vci"``: G of the corrected test gradients, and the Dirichlet consistency term
+    with the stress recovered at the boundary's Gauss points from the points' (the history lives there)."""
+    if case.method.boundary != "alpha":
+        raise ProblemError("method.integration = \"ctm-vci\" integrates over the node loops of the tracked boundary: "
+                           "set method.boundary = \"alpha\"", key="method.integration")
+    boundary = consistent_integration.boundary_quadrature(conf.x, conf.boundary.edges)
+    N_b = conf.shape_functions_at(boundary.points, derivatives=False).N
+    thickness = case.problem.thickness
+    test_dx, test_dy = consistent_integration.corrected_gradients(
+        conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf, boundary, N_b, case.method.correction)
+    R = recovery_operator(boundary.points, conf.points, conf.w, conf.lengths.d_c)
+    term = consistent_integration.RecoveredDirichletTerm(len(conf.x), tags.fixed, boundary, N_b, R, thickness)
+    return gradient_operator(test_dx, test_dy), term
 
 
 def solve_elastoplastic(case: Case, progress: Callable[[Any], None] = lambda level: None) -> Result:

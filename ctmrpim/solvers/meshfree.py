@@ -24,11 +24,13 @@ def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Resu
     """Solve ``case`` with CTM-RPIM (``element`` is always None: the method has none)."""
     analysis = case.problem.analysis
     scheme = case.method.integration
+    plastic = isinstance(case.problem.material, MohrCoulomb) and analysis != "explicit"
     total_lagrangian = (analysis == "quasi-static" and case.method.formulation == "total-lagrangian"
-                        and not isinstance(case.problem.material, MohrCoulomb))
-    if scheme != "ctm" and analysis != "linear" and not (scheme == "ctm-vci" and total_lagrangian):
+                        and not plastic)
+    if scheme != "ctm" and analysis != "linear" and not (scheme == "ctm-vci" and (total_lagrangian or plastic)):
         raise ProblemError(f"method.integration = {scheme!r} is implemented for linear analyses"
-                           + (" and (ctm-vci) the total-Lagrangian formulation" if scheme == "ctm-vci" else "")
+                           + (", the total-Lagrangian formulation and the small-strain Mohr-Coulomb solvers"
+                              if scheme == "ctm-vci" else "")
                            + f"; this {analysis!r} analysis integrates with \"ctm\"", key="method.integration")
     if analysis == "explicit":
         from ctmrpim.solvers.explicit.run import solve_explicit

@@ -92,9 +92,11 @@ class PlasticSystem:
     tangents: int = 0                       # tangents built
     factorisations: int = 0                 # LU factorisations (a tangent equal to the last one reuses them)
     clock: Timer = field(default_factory=Timer)   # seconds per phase of the iterations
+    test: sp.bsr_matrix | None = None       # ctm-vci: G of the corrected test gradients (Petrov-Galerkin)
+    dirichlet: Any = None                   # ctm-vci: its Dirichlet consistency term (RecoveredDirichletTerm)
 
     def __post_init__(self) -> None:
-        self.GT = self.G.T
+        self.GT = (self.G if self.test is None else self.test).T
         self.U = np.zeros(self.G.shape[1])
         self.stress = np.zeros((len(self.w), 4))
         self.region = np.zeros(len(self.w), dtype=np.int8)
@@ -129,11 +131,24 @@ class PlasticSystem:
             D = self.material.D("strain")
             A = np.broadcast_to(TO_P @ D @ FROM_GRAD, (len(self.w), 4, 4))
             self._K_elastic = tangent(self.G, A, self.w, self.GT)
+            if self.consistent:
+                self._K_elastic = self._K_elastic - self.dirichlet.stiffness(self.G, np.ascontiguousarray(A))
         return self._K_elastic
+
+    @property
+    def consistent(self) -> bool:
+        """Whether a Dirichlet consistency term acts (ctm-vci with constrained edges)."""
+        return self.dirichlet is not None and self.dirichlet.active
+
+    def _internal(self, stress: np.ndarray) -> np.ndarray:
+        """G~^T (w sigma), less the Dirichlet consistency term's force where there is one."""
+        P = stress[:, :3] @ TO_P.T
+        f = internal_force(self.G, P, self.w, self.GT)
+        return f - self.dirichlet.force(P) if self.consistent else f
 
     def internal_force(self) -> np.ndarray:
         """G^T (w sigma) of the committed stress (with the reactions at the fixed dofs)."""
-        return internal_force(self.G, self.stress[:, :3] @ TO_P.T, self.w, self.GT)
+        return self._internal(self.stress)
 
     def snapshot(self) -> tuple[np.ndarray, ...]:
         """Copies of the committed (U, stress, region, plastic strain), for :meth:`restore`."""
@@ -152,7 +167,7 @@ class PlasticSystem:
             stress, region = material.update(self.stress, de)
         with self.clock.measure("internal force"):
             f_ext = self.external_force(load_factor)
-            f_int = internal_force(self.G, stress[:, :3] @ TO_P.T, self.w, self.GT)
+            f_int = self._internal(stress)
         with self.clock.measure("tangent"):
             self.elastic_stiffness()
             if self.tangent == "elastic":
@@ -167,7 +182,10 @@ class PlasticSystem:
                     dA = TO_P[None] @ (material.tangent(self.stress[plastic], de[plastic])
                                        - material.D("strain")[None]) @ FROM_GRAD[None]
                     Gp = block_rows(self.G, plastic)
-                    self._K = self._K_elastic + tangent(Gp, dA, self.w[plastic], Gp.T)
+                    GTp = Gp.T if self.test is None else block_rows(self.test, plastic).T
+                    self._K = self._K_elastic + tangent(Gp, dA, self.w[plastic], GTp)
+                    if self.consistent:
+                        self._K = self._K - self.dirichlet.stiffness(Gp, dA, plastic)
                 self.tangents += 1
         return f_ext, f_int, self._K
 
