@@ -97,7 +97,20 @@ class Method:
 
     def __post_init__(self) -> None:
         self.line_spacing = tuple(float(v) for v in self.line_spacing)
-        validate("method", self, [
+        validate("method", self, self.rules())
+        nearest = round(self.eta)
+        if nearest % 2 == 0 and abs(self.eta - nearest) < 1e-9:
+            raise ProblemError(
+                f"eta = {self.eta:g} is an even integer: r^eta is then a polynomial and the RPIM moment "
+                "matrix is singular; use an odd integer or a fraction (the paper uses 5.0)", key="method.eta")
+        if nearest % 2 == 0 and abs(self.eta - nearest) < 0.1:
+            warnings.warn(f"method.eta = {self.eta:g} is close to the even integer {nearest}: the RPIM moment "
+                          "matrix is nearly singular there", stacklevel=2)
+
+    def rules(self) -> list[tuple[str, bool, str]]:
+        """(key, holds, what is allowed) per setting: :func:`validate` raises for the first that fails; the
+        problem-file reference (:mod:`ctmrpim.problem.schema`) prints the allowed values."""
+        return [
             ("support_radius", self.support_radius > 0, "must be > 0"),
             ("eta", self.eta > 0, "must be > 0"),
             ("polynomial", isinstance(self.polynomial, str) and self.polynomial in POLYNOMIAL_TERMS,
@@ -115,15 +128,7 @@ class Method:
             ("min_support", integer(self.min_support, 0), "must be an integer >= 0 (0: off)"),
             ("integration", self.integration in INTEGRATIONS, f"must be one of {list(INTEGRATIONS)}"),
             ("correction", self.correction in CORRECTIONS, f"must be one of {list(CORRECTIONS)}"),
-        ])
-        nearest = round(self.eta)
-        if nearest % 2 == 0 and abs(self.eta - nearest) < 1e-9:
-            raise ProblemError(
-                f"eta = {self.eta:g} is an even integer: r^eta is then a polynomial and the RPIM moment "
-                "matrix is singular; use an odd integer or a fraction (the paper uses 5.0)", key="method.eta")
-        if nearest % 2 == 0 and abs(self.eta - nearest) < 0.1:
-            warnings.warn(f"method.eta = {self.eta:g} is close to the even integer {nearest}: the RPIM moment "
-                          "matrix is nearly singular there", stacklevel=2)
+        ]
 
     @property
     def polynomial_terms(self) -> int:
@@ -157,14 +162,18 @@ class Loading:
                                    # load bracketed (no error); the limit load of a footing
 
     def __post_init__(self) -> None:
-        validate("loading", self, [
+        validate("loading", self, self.rules())
+
+    def rules(self) -> list[tuple[str, bool, str]]:
+        """(key, holds, what is allowed) per setting (see :meth:`Method.rules`)."""
+        return [
             ("until_failure", isinstance(self.until_failure, bool), "must be true or false"),
             ("tangent", self.tangent in ("consistent", "elastic"), "must be \"consistent\" or \"elastic\""),
             ("steps", integer(self.steps, 1), "must be an integer >= 1"),
             ("tolerance", not isinstance(self.tolerance, bool) and 0 < self.tolerance < 1, "must lie in (0, 1)"),
             ("max_iterations", integer(self.max_iterations, 1), "must be an integer >= 1"),
             ("max_cutbacks", integer(self.max_cutbacks, 0), "must be an integer >= 0"),
-        ])
+        ]
 
 
 @dataclass(frozen=True)
@@ -181,7 +190,11 @@ class StrengthReduction:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "values", tuple(float(v) for v in self.values))
-        validate("strength-reduction", self, [
+        validate("strength-reduction", self, self.rules())
+
+    def rules(self) -> list[tuple[str, bool, str]]:
+        """(key, holds, what is allowed) per setting (see :meth:`Method.rules`)."""
+        return [
             ("solver", self.solver in REDUCTION_SOLVERS, f"must be one of {list(REDUCTION_SOLVERS)}"),
             ("start", self.start > 0, "must be > 0"),
             ("step", self.step > 0, "must be > 0"),
@@ -189,7 +202,7 @@ class StrengthReduction:
             ("max_srf", self.max_srf > self.start, "must exceed start"),
             ("steps", integer(self.steps, 1), "must be an integer >= 1"),
             ("values", all(v > 0 for v in self.values), "must all be > 0"),
-        ])
+        ]
 
 
 @dataclass(frozen=True)
@@ -202,12 +215,16 @@ class Relaxation:
     record_every: int = 10       # history: every this many steps
 
     def __post_init__(self) -> None:
-        validate("dynamic", self, [
+        validate("dynamic", self, self.rules())
+
+    def rules(self) -> list[tuple[str, bool, str]]:
+        """(key, holds, what is allowed) per setting (see :meth:`Method.rules`)."""
+        return [
             ("steps", integer(self.steps, 1), "must be an integer >= 1"),
             ("damping", 0.0 <= self.damping < 1.0, "must lie in [0, 1)"),
             ("tolerance", 0.0 < self.tolerance < 1.0, "must lie in (0, 1)"),
             ("record_every", integer(self.record_every, 1), "must be an integer >= 1"),
-        ])
+        ]
 
 
 @dataclass(frozen=True)
@@ -216,7 +233,7 @@ class Explicit:
 
     duration: float = 1.0          # simulated time after the gate is removed (s)
     dt: float | str = "cfl"        # time step (s), or "cfl": cfl x 2 / omega_max, recomputed at each rebuild
-    cfl: float = 0.5
+    cfl: float = 0.5               # dt = cfl x 2 / omega_max: the share of the stability limit taken
     damping: float = 0.0           # local damping factor f of Eq. (11); 0: true dynamics
     viscosity: float = 0.0         # beta (s): stiffness-proportional damping, a viscous stress beta D d(eps)/dt
     rebuild_strain: float = 0.2    # RPIM rebuilt once a point is strained this much since the last rebuild
@@ -233,7 +250,11 @@ class Explicit:
     detached: str = "stop"         # a node that leaves the body: "stop" the run, or let it go "free"
 
     def __post_init__(self) -> None:
-        validate("explicit", self, [
+        validate("explicit", self, self.rules())
+
+    def rules(self) -> list[tuple[str, bool, str]]:
+        """(key, holds, what is allowed) per setting (see :meth:`Method.rules`)."""
+        return [
             ("duration", self.duration > 0, "must be > 0"),
             ("dt", self.dt == "cfl" or (isinstance(self.dt, (int, float)) and not isinstance(self.dt, bool)
                                         and self.dt > 0), "must be \"cfl\" or a time step > 0 (s)"),
@@ -251,4 +272,4 @@ class Explicit:
             ("stage_tolerance", 0 < self.stage_tolerance < 1, "must lie in (0, 1)"),
             ("stage_steps", integer(self.stage_steps, 1), "must be an integer >= 1"),
             ("detached", self.detached in ("stop", "free"), "must be \"stop\" or \"free\""),
-        ])
+        ]

@@ -1,7 +1,7 @@
 """The sections and keys a problem file may hold, and the check that it holds no others.
 
 Unknown sections and keys are errors with the closest known name suggested; missing required
-sections and keys are named.
+sections and keys are named. The sections and keys are the schema's (:mod:`ctmrpim.problem.schema`).
 """
 from __future__ import annotations
 
@@ -9,32 +9,14 @@ import difflib
 from collections.abc import Iterable
 
 from ctmrpim.errors import ProblemError
-from ctmrpim.problem.settings import Explicit, Loading, Method, Relaxation, StrengthReduction
+from ctmrpim.problem import schema
 
-SECTIONS: dict[str, set[str] | None] = {
-    "problem": {"name", "analysis", "plane", "thickness", "description", "gravity"},
-    "parameters": None,  # any names
-    "geometry": {"add", "subtract"},
-    "nodes": {"grid", "spacing", "file"},
-    "material": {"model", "E", "nu", "density", "c", "phi", "psi", "tension"},
-    "method": set(Method.__dataclass_fields__),
-    "constraint": {"where", "ux", "uy"},
-    "traction": {"where", "tx", "ty", "follower"},
-    "pressure": {"where", "p"},
-    "probe": {"name", "at"},
-    "point_load": {"at", "fx", "fy"},
-    "exact": {"ux", "uy", "sxx", "syy", "sxy"},
-    "body-force": {"bx", "by"},
-    "loading": set(Loading.__dataclass_fields__),
-    "strength-reduction": set(StrengthReduction.__dataclass_fields__),
-    "dynamic": set(Relaxation.__dataclass_fields__),
-    "explicit": set(Explicit.__dataclass_fields__),
-    "wall": {"name", "point", "normal", "friction", "gate"},
-}
-LIST_SECTIONS = {"constraint", "traction", "pressure", "probe", "point_load", "wall"}
-REQUIRED = {"problem": ["name"], "geometry": ["add"], "material": ["model", "E", "nu"],
-            "constraint": ["where"], "traction": ["where"], "pressure": ["where", "p"],
-            "probe": ["name", "at"], "point_load": ["at"], "wall": ["name", "point", "normal"]}
+#: section -> its keys (None: any names), from the schema the reference documentation is generated from
+SECTIONS: dict[str, set[str] | None] = {s.name: None if s.keys is None else {k.name for k in s.keys}
+                                        for s in schema.SECTIONS}
+LIST_SECTIONS = {s.name for s in schema.SECTIONS if s.listed}
+REQUIRED = {s.name: [k.name for k in s.keys if k.default == schema.REQUIRED]
+            for s in schema.SECTIONS if s.keys and any(k.default == schema.REQUIRED for k in s.keys)}
 #: Names people reach for instead of the file's keys, to suggest where difflib finds no close spelling.
 SYNONYMS = {"youngs": "E", "young": "E", "youngs_modulus": "E", "young_modulus": "E", "modulus": "E",
             "poisson": "nu", "poissons_ratio": "nu", "poisson_ratio": "nu", "rho": "density"}
