@@ -182,7 +182,10 @@ def test_ctrl_c_exits_130_and_keeps_the_checkpoint(tmp_path) -> None:
                                       "explicit.duration=5", "--set", "explicit.checkpoint_every=20",
                                       "--set", "explicit.rest=1e-12",   # no early rest: the run outlasts the signal
                                       "--out", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            # a test run in the background of a non-interactive shell (CI, the fresh-checkout check)
+                            # inherits SIGINT ignored, and Python then keeps ignoring it: give the child the default
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.time() + 120
     while time.time() < deadline and proc.poll() is None and not (out / "checkpoint.npz").is_file():
         time.sleep(0.05)
