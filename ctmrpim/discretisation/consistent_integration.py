@@ -28,6 +28,7 @@ written as the traction of the discrete solution, t = sigma(u_h) n: :func:`diric
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -35,6 +36,11 @@ import scipy.sparse as sp
 from ctmrpim.discretisation.ctm import BoundaryQuadrature, boundary_points
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator, value_operator
 from ctmrpim.discretisation.rpim import ShapeFunctions
+from ctmrpim.errors import ProblemError
+
+if TYPE_CHECKING:
+    from ctmrpim.discretisation.configuration import Configuration
+    from ctmrpim.problem.settings import Method
 
 #: Gauss points per boundary segment, for the correction and the tractions alike (mixing 2 and 3 points
 #: per segment failed the patch test at 0.86 % in energy while this was calibrated)
@@ -95,6 +101,22 @@ def corrected_gradients(nodes: np.ndarray, d_c: float, points: np.ndarray, w: np
     c[used] = np.linalg.solve(M[used], R[used])
     return tuple(sp.csr_matrix((d.data + np.einsum("ea,ea->e", q, c[cols, :, k]), d.indices, d.indptr),
                                shape=d.shape) for k, d in enumerate((dx, dy)))
+
+
+def corrected_test_gradients(conf: Configuration, method: Method, thickness: float
+                             ) -> tuple[BoundaryQuadrature, ShapeFunctions, sp.csr_matrix, sp.csr_matrix]:
+    """What every solver path with ``method.integration = "ctm-vci"`` starts from, on a configuration ``conf``
+    integrated over its tracked node loops: the boundary's Gauss points, the shape functions there and the
+    corrected test gradients d~N/dx, d~N/dy at the configuration's points (weights without the ``thickness``)."""
+    if method.boundary != "alpha":
+        raise ProblemError("method.integration = \"ctm-vci\" integrates over the node loops of the tracked boundary: "
+                           "set method.boundary = \"alpha\", or method.integration = \"ctm\" for the paper's scheme",
+                           key="method.integration")
+    boundary = boundary_quadrature(conf.x, conf.boundary.edges)
+    sf_b = conf.shape_functions_at(boundary.points)
+    test_dx, test_dy = corrected_gradients(conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf,
+                                           boundary, sf_b.N, method.correction)
+    return boundary, sf_b, test_dx, test_dy
 
 
 def dirichlet_consistency(n_nodes: int, fixed: np.ndarray, boundary: BoundaryQuadrature, sf: ShapeFunctions,

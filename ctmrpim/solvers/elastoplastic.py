@@ -51,16 +51,10 @@ def _consistent(case: Case, conf: Configuration, tags: BoundaryTags
                 ) -> tuple[sp.bsr_matrix, consistent_integration.RecoveredDirichletTerm]:
     """``method.integration = "ctm-vci"``: G of the corrected test gradients, and the Dirichlet consistency term
     with the stress recovered at the boundary's Gauss points from the points' (the history lives there)."""
-    if case.method.boundary != "alpha":
-        raise ProblemError("method.integration = \"ctm-vci\" integrates over the node loops of the tracked boundary: "
-                           "set method.boundary = \"alpha\"", key="method.integration")
-    boundary = consistent_integration.boundary_quadrature(conf.x, conf.boundary.edges)
-    N_b = conf.shape_functions_at(boundary.points, derivatives=False).N
     thickness = case.problem.thickness
-    test_dx, test_dy = consistent_integration.corrected_gradients(
-        conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf, boundary, N_b, case.method.correction)
+    boundary, sf_b, test_dx, test_dy = consistent_integration.corrected_test_gradients(conf, case.method, thickness)
     R = recovery_operator(boundary.points, conf.points, conf.w, conf.lengths.d_c)
-    term = consistent_integration.RecoveredDirichletTerm(len(conf.x), tags.fixed, boundary, N_b, R, thickness)
+    term = consistent_integration.RecoveredDirichletTerm(len(conf.x), tags.fixed, boundary, sf_b.N, R, thickness)
     return gradient_operator(test_dx, test_dy), term
 
 

@@ -34,15 +34,8 @@ ERROR_MIN_BAND = 0.25   # merge vertex ordinates closer than this (x d_c): circl
 def consistent_stiffness(case: Case, conf: Configuration, tags: BoundaryTags, D: np.ndarray) -> sp.csr_matrix:
     """K (2n x 2n) of ``method.integration = "ctm-vci"``: Petrov-Galerkin with the corrected test gradients,
     minus the Dirichlet consistency term (:mod:`ctmrpim.discretisation.consistent_integration`)."""
-    if case.method.boundary != "alpha":
-        raise ProblemError("method.integration = \"ctm-vci\" (the default of linear analyses) integrates over the "
-                           "node loops of the tracked boundary: set method.boundary = \"alpha\", or "
-                           "method.integration = \"ctm\" for the paper's scheme", key="method.integration")
-    boundary = consistent_integration.boundary_quadrature(conf.x, conf.boundary.edges)
-    sf_b = conf.shape_functions_at(boundary.points)
     thickness = case.problem.thickness
-    test_dx, test_dy = consistent_integration.corrected_gradients(
-        conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf, boundary, sf_b.N, case.method.correction)
+    boundary, sf_b, test_dx, test_dy = consistent_integration.corrected_test_gradients(conf, case.method, thickness)
     K = assembly.stiffness(conf.sf.dNdx, conf.sf.dNdy, conf.w, D, test=(test_dx, test_dy))
     return K - consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, boundary, sf_b, D, thickness)
 

@@ -44,14 +44,8 @@ def _consistent(case: Case, conf: Configuration, tags: BoundaryTags
     """``method.integration = "ctm-vci"`` on the reference configuration: G~^T of the corrected test gradients
     (the integration constraints hold against the boundary's Gauss points) and the Dirichlet consistency term
     (:mod:`ctmrpim.discretisation.consistent_integration`); K = G~^T diag(w A) G is Petrov-Galerkin."""
-    if case.method.boundary != "alpha":
-        raise ProblemError("method.integration = \"ctm-vci\" integrates over the node loops of the tracked boundary: "
-                           "set method.boundary = \"alpha\"", key="method.integration")
-    boundary = consistent_integration.boundary_quadrature(conf.x, conf.boundary.edges)
-    sf_b = conf.shape_functions_at(boundary.points)
     thickness = case.problem.thickness
-    test_dx, test_dy = consistent_integration.corrected_gradients(
-        conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf, boundary, sf_b.N, case.method.correction)
+    boundary, sf_b, test_dx, test_dy = consistent_integration.corrected_test_gradients(conf, case.method, thickness)
     term = consistent_integration.LagrangianDirichletTerm(len(conf.x), tags.fixed, boundary, sf_b, thickness)
     return gradient_operator(test_dx, test_dy).T.tobsr(), term
 
