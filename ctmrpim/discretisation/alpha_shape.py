@@ -105,8 +105,7 @@ def alpha_shape(points: np.ndarray, alpha: float, d_c: float, reference: np.ndar
     except MemoryError:
         raise ProblemError(f"alpha shape: out of memory triangulating {len(points)} nodes") from None
     tri = dt.simplices.copy()
-    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
-    cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
+    cw = _doubled_areas(points, tri) < 0
     tri[cw] = tri[cw][:, [0, 2, 1]]
     keep = circumradii(points, tri) < alpha
     body = np.ones(len(tri), bool) if inside is None else np.asarray(inside(points[tri].mean(axis=1)), bool)
@@ -232,8 +231,7 @@ def validate(boundary: Boundary, expected_area: float | None = None, area_tol: f
         vals, cnt = np.unique(lp, return_counts=True)
         if np.any(cnt > 1):
             raise ProblemError(f"alpha shape: loop is not simple at node(s) {vals[cnt > 1].tolist()[:5]}")
-    a, b, c = (pts[boundary.triangles[:, i]] for i in range(3))
-    tri_area = 0.5 * np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])).sum()
+    tri_area = 0.5 * np.abs(_doubled_areas(pts, boundary.triangles)).sum()
     if abs(boundary.area - tri_area) > 1e-9 * max(tri_area, 1e-300):
         raise ProblemError(f"alpha shape: loops enclose {boundary.area:g} but the kept triangles cover {tri_area:g}")
     outer = [lp for lp in boundary.loops if signed_area(pts[lp]) > 0]

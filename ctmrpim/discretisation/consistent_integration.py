@@ -145,6 +145,22 @@ def dirichlet_consistency(n_nodes: int, fixed: np.ndarray, boundary: BoundaryQua
     return C.tocsr()
 
 
+def _constrained_traction_forces(n_nodes: int, fixed: np.ndarray, boundary: BoundaryQuadrature, N: sp.csr_matrix,
+                                 thickness: float) -> tuple[sp.csr_matrix, bool]:
+    """S (2n x 2b), tractions (b, 2) at the ``boundary`` points -> forces sum_b w_b N_I(x_b) t_k(x_b), on the
+    components k prescribed (``fixed``) at both ends of a point's segment only, and whether there is any. The
+    rows of prescribed dofs are dropped: their equations are replaced by the prescribed values, and the internal
+    force there stays the reaction (the Newton iteration measures its residual against it)."""
+    prescribed = np.zeros(2 * n_nodes, bool)
+    prescribed[fixed] = True
+    ends = boundary.ends
+    on = np.stack([prescribed[2 * ends[:, 0] + k] & prescribed[2 * ends[:, 1] + k] for k in (0, 1)], axis=1)
+    rows, cols = np.nonzero(on)
+    b = len(boundary.weights)
+    W = sp.csr_matrix((boundary.weights[rows] * thickness, (2 * rows + cols, 2 * rows + cols)), shape=(2 * b, 2 * b))
+    return (sp.diags((~prescribed).astype(float)) @ value_operator(N).T @ W).tocsr(), bool(on.any())
+
+
 class LagrangianDirichletTerm:
     """The Dirichlet consistency term of a total-Lagrangian (hyperelastic) solve with ``ctm-vci``: the large-
     deformation form of :func:`dirichlet_consistency`, subtracted from the internal force,
@@ -158,19 +174,8 @@ class LagrangianDirichletTerm:
 
     def __init__(self, n_nodes: int, fixed: np.ndarray, boundary: BoundaryQuadrature, sf: ShapeFunctions,
                  thickness: float) -> None:
-        prescribed = np.zeros(2 * n_nodes, bool)
-        prescribed[fixed] = True
-        ends = boundary.ends
-        on = np.stack([prescribed[2 * ends[:, 0] + k] & prescribed[2 * ends[:, 1] + k] for k in (0, 1)], axis=1)
-        self.active = bool(on.any())
+        self.S, self.active = _constrained_traction_forces(n_nodes, fixed, boundary, sf.N, thickness)
         self.normals = boundary.normals
-        rows, cols = np.nonzero(on)
-        b = len(boundary.weights)
-        # W (2b x 2b): w_b on the rows (b, k) with component k prescribed; S = N^T W maps tractions to forces
-        W = sp.csr_matrix((boundary.weights[rows] * thickness, (2 * rows + cols, 2 * rows + cols)), shape=(2 * b, 2 * b))
-        # rows of prescribed dofs dropped: their equations are replaced by the prescribed values, and the internal
-        # force there stays the reaction (the Newton iteration measures its residual against it)
-        self.S = (sp.diags((~prescribed).astype(float)) @ value_operator(sf.N).T @ W).tocsr()
         self.G = gradient_operator(sf.dNdx, sf.dNdy)
 
     def __call__(self, U: np.ndarray, stress_tangent: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
@@ -199,22 +204,15 @@ class RecoveredDirichletTerm:
 
     def __init__(self, n_nodes: int, fixed: np.ndarray, boundary: BoundaryQuadrature, N_boundary: sp.csr_matrix,
                  recovery: sp.csr_matrix, thickness: float) -> None:
-        prescribed = np.zeros(2 * n_nodes, bool)
-        prescribed[fixed] = True
-        ends = boundary.ends
-        on = np.stack([prescribed[2 * ends[:, 0] + k] & prescribed[2 * ends[:, 1] + k] for k in (0, 1)], axis=1)
-        rows, cols = np.nonzero(on)
+        S, self.active = _constrained_traction_forces(n_nodes, fixed, boundary, N_boundary, thickness)
         b = len(boundary.weights)
-        W = sp.csr_matrix((boundary.weights[rows] * thickness, (2 * rows + cols, 2 * rows + cols)), shape=(2 * b, 2 * b))
         nx, ny = boundary.normals[:, 0], boundary.normals[:, 1]
         # t_x = s_xX n_x + s_xY n_y, t_y = s_yX n_x + s_yY n_y on the stress layout xX, xY, yX, yY
         blocks = np.zeros((b, 2, 4))
         blocks[:, 0, 0], blocks[:, 0, 1], blocks[:, 1, 2], blocks[:, 1, 3] = nx, ny, nx, ny
         Nn = sp.bsr_matrix((blocks, np.arange(b), np.arange(b + 1)), shape=(2 * b, 4 * b))
         R4 = sp.kron(recovery, sp.identity(4), format="csr")
-        self.active = bool(on.any())
-        # (2n x 4m): stresses -> forces; rows of prescribed dofs dropped, as in LagrangianDirichletTerm
-        self.operator = (sp.diags((~prescribed).astype(float)) @ value_operator(N_boundary).T @ W @ Nn @ R4).tocsc()
+        self.operator = (S @ Nn @ R4).tocsc()     # (2n x 4m): the points' stresses -> forces
 
     def force(self, P: np.ndarray) -> np.ndarray:
         """(2n,) the term's force of the stresses P (m, 4: xX, xY, yX, yY) at the integration points."""
