@@ -4,6 +4,11 @@ On a single axis-aligned rectangle ``grid = [nx, ny]`` is the exact tensor grid 
 17 x 5 ... 257 x 65 clouds). On any other body nodes are placed along every boundary loop at about
 the grid spacing (corners kept, circles snapped onto their true arcs) and a regular grid fills the
 inside, keeping clear of the boundary by at least ``CLEARANCE`` spacings.
+
+``jitter`` (a fraction of the spacing, with ``seed``) makes a generated cloud irregular: every node off the
+boundary moves by a uniform random offset in [-jitter h, jitter h] along each axis, so a method can be checked
+on clouds that are not grids (the tensor order is kept, so a quadrilateral mesh of the grid stays valid). An
+offset that would bring a node nearer the boundary than ``JITTER_CLEARANCE`` spacings is not applied.
 """
 from __future__ import annotations
 
@@ -19,15 +24,19 @@ from ctmrpim.problem.geometry import Geometry
 
 CLEARANCE = 0.5     # interior grid nodes closer than this (x spacing) to a boundary node are dropped
 CORNER_ANGLE = math.radians(20.0)  # a boundary vertex turning more than this is kept as a node
+MAX_JITTER = 0.4    # largest nodes.jitter: two neighbours moved towards each other stay 0.2 h apart
+JITTER_CLEARANCE = 0.25   # a jittered node keeps this (x spacing) from the boundary, else it stays put
 
 
 @dataclass(frozen=True)
 class NodeSpec:
-    """Exactly one of ``grid``, ``spacing`` or ``file``."""
+    """Exactly one of ``grid``, ``spacing`` or ``file``; ``jitter`` and ``seed`` move generated nodes."""
 
     grid: tuple[int, int] | None = None
     spacing: float | None = None
     file: str | None = None
+    jitter: float = 0.0
+    seed: int | None = None
 
     def __post_init__(self) -> None:
         given = [k for k in ("grid", "spacing", "file") if getattr(self, k) is not None]
@@ -38,11 +47,22 @@ class NodeSpec:
             raise ProblemError(f"grid = {list(self.grid)} needs two integers >= 2", key="nodes.grid")
         if self.spacing is not None and not self.spacing > 0:
             raise ProblemError(f"spacing = {self.spacing} must be > 0", key="nodes.spacing")
+        if not 0.0 <= self.jitter <= MAX_JITTER:
+            raise ProblemError(f"jitter = {self.jitter:g} must lie in [0, {MAX_JITTER:g}] (a fraction of the spacing)",
+                               key="nodes.jitter")
+        if self.jitter and self.file is not None:
+            raise ProblemError("jitter moves generated nodes; the nodes of a file are used as given", key="nodes.jitter")
+        if self.seed is not None and not self.jitter:
+            raise ProblemError(f"seed = {self.seed} has no effect without nodes.jitter > 0", key="nodes.seed")
 
     def as_dict(self) -> dict:
-        """The given one of ``grid`` (as a list), ``spacing`` or ``file``, as ``summary.json`` reports it."""
-        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in
-                (("grid", self.grid), ("spacing", self.spacing), ("file", self.file)) if v is not None}
+        """The given one of ``grid`` (as a list), ``spacing`` or ``file``, and the jitter with its seed, as
+        ``summary.json`` reports them."""
+        out = {k: (list(v) if isinstance(v, tuple) else v) for k, v in
+               (("grid", self.grid), ("spacing", self.spacing), ("file", self.file)) if v is not None}
+        if self.jitter:
+            out.update(jitter=self.jitter, seed=self.seed or 0)
+        return out
 
 
 def make_nodes(geometry: Geometry, spec: NodeSpec, base_dir: Path | None = None) -> np.ndarray:
@@ -52,13 +72,31 @@ def make_nodes(geometry: Geometry, spec: NodeSpec, base_dir: Path | None = None)
         return _read_nodes(geometry, Path(base_dir or ".") / spec.file)
     if spec.grid is not None:
         nx, ny = spec.grid
+        hx, hy = (x1 - x0) / (nx - 1), (y1 - y0) / (ny - 1)
         if geometry.is_rectangle():
             X, Y = np.meshgrid(np.linspace(x0, x1, nx), np.linspace(y0, y1, ny), indexing="xy")
-            return np.c_[X.ravel(), Y.ravel()]
-        hx, hy = (x1 - x0) / (nx - 1), (y1 - y0) / (ny - 1)
+            return _jittered(geometry, np.c_[X.ravel(), Y.ravel()], hx, hy, spec)
     else:
         hx = hy = float(spec.spacing)
-    return _fill(geometry, hx, hy)
+    return _jittered(geometry, _fill(geometry, hx, hy), hx, hy, spec)
+
+
+def _jittered(geometry: Geometry, nodes: np.ndarray, hx: float, hy: float, spec: NodeSpec) -> np.ndarray:
+    """``nodes`` (n, 2) with those off the boundary moved by ``spec.jitter`` of the spacings (hx, hy) at random
+    (uniform per axis, generator seeded by ``spec.seed``); boundary nodes, and moves that would come nearer the
+    boundary than JITTER_CLEARANCE spacings, stay put."""
+    if not spec.jitter:
+        return nodes
+    h = min(hx, hy)
+    offset = np.random.default_rng(spec.seed or 0).uniform(-1.0, 1.0, nodes.shape) * spec.jitter * np.array([hx, hy])
+    off_boundary = geometry.distance_to_boundary(nodes) > 1e-9 * h
+    moved = nodes + offset
+    keeps_clear = (geometry.distance_outside(moved) == 0.0) & (geometry.distance_to_boundary(moved)
+                                                               > JITTER_CLEARANCE * h)
+    out = nodes.copy()
+    take = off_boundary & keeps_clear
+    out[take] = moved[take]
+    return out
 
 
 def _fill(geometry: Geometry, hx: float, hy: float) -> np.ndarray:

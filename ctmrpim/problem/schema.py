@@ -134,6 +134,9 @@ SECTIONS: tuple[Section, ...] = (
         Key("spacing", NUMBER, OPTIONAL, "> 0", "length", "a square grid of this spacing"),
         Key("file", "string", OPTIONAL, "a CSV file with a header row and columns x, y", "",
             "node positions; the path is relative to the problem file"),
+        Key("jitter", NUMBER, "0", "0 to 0.4", "spacing", "moves every generated node off the boundary by a "
+            "random offset of up to this fraction of the spacing along each axis (an irregular cloud)"),
+        Key("seed", "integer", "0", ">= 0", "", "the random generator's seed of jitter (only with jitter)"),
     ), "the field nodes"),
     Section("material", ALL, (
         Key("model", "string", REQUIRED, "linear-elastic, neo-hookean, mohr-coulomb", "",

@@ -82,3 +82,47 @@ def test_a_hole_the_cloud_cannot_resolve_is_refused(tmp_path) -> None:
         ctmrpim.solve(parse_case(raw, "p", tmp_path))
     raw["geometry"]["subtract"][0]["circle"][2] = 0.12            # resolved: two loops
     assert ctmrpim.solve(parse_case(raw, "p", tmp_path)).counts["boundary_loops"] == 2
+
+
+@pytest.mark.parametrize("spec", [NodeSpec(grid=(17, 9), jitter=0.4), NodeSpec(spacing=0.5, jitter=0.4, seed=3)])
+def test_jitter_moves_interior_nodes_only_within_bounds(spec: NodeSpec) -> None:
+    """An L-shape (re-entrant corner): boundary nodes stay, interior nodes move by at most jitter h per axis, keep
+    JITTER_CLEARANCE h from the boundary, the tensor order is kept, and one seed gives one cloud."""
+    from ctmrpim.problem.node_cloud import JITTER_CLEARANCE
+
+    g = Geometry(add=[Shape("polygon", ((0.0, 0.0), (8.0, 0.0), (8.0, 4.0), (4.0, 4.0), (4.0, 8.0), (0.0, 8.0)))])
+    plain = make_nodes(g, NodeSpec(grid=spec.grid, spacing=spec.spacing))
+    moved = make_nodes(g, spec)
+    h = np.array([8 / 16, 8 / 8]) if spec.grid else np.array([0.5, 0.5])
+    step = moved - plain
+    on_boundary = g.distance_to_boundary(plain) < 1e-12
+    assert np.all(step[on_boundary] == 0.0)
+    assert np.all(np.abs(step) <= spec.jitter * h + 1e-12)
+    assert np.count_nonzero(step.any(axis=1)) > 0.8 * np.count_nonzero(~on_boundary)   # most moved
+    assert np.all(g.distance_to_boundary(moved[~on_boundary]) > JITTER_CLEARANCE * h.min())
+    assert np.all(g.distance_outside(moved) == 0.0)
+    check_nodes_inside(g, moved, tol=1e-12)
+    np.testing.assert_array_equal(make_nodes(g, spec), moved)
+    other = make_nodes(g, NodeSpec(grid=spec.grid, spacing=spec.spacing, jitter=spec.jitter, seed=(spec.seed or 0) + 1))
+    assert not np.array_equal(other, moved)
+
+
+@pytest.mark.parametrize("kwargs, key", [({"grid": (5, 5), "jitter": 0.5}, "nodes.jitter"),
+                                          ({"grid": (5, 5), "jitter": -0.1}, "nodes.jitter"),
+                                          ({"file": "n.csv", "jitter": 0.2}, "nodes.jitter"),
+                                          ({"grid": (5, 5), "seed": 2}, "nodes.seed")])
+def test_jitter_settings_that_cannot_act_are_refused(kwargs: dict, key: str) -> None:
+    from ctmrpim.errors import ProblemError
+
+    with pytest.raises(ProblemError) as info:
+        NodeSpec(**kwargs)
+    assert info.value.key == key
+
+
+def test_jitter_on_the_command_line_keeps_the_grid() -> None:
+    """--set nodes.jitter=... adds to the file's grid (the placement keys alone replace each other)."""
+    case = benchmarks.load("cantilever", ["nodes.grid=[17, 5]", "nodes.jitter=0.3", "nodes.seed=2"])
+    assert case.nodes.grid == (17, 5) and case.nodes.jitter == 0.3 and case.nodes.seed == 2
+    assert case.nodes.as_dict() == {"grid": [17, 5], "jitter": 0.3, "seed": 2}
+    case = benchmarks.load("cantilever", ["nodes.jitter=0.3", "nodes.spacing=1.5"])
+    assert case.nodes.grid is None and case.nodes.spacing == 1.5 and case.nodes.jitter == 0.3

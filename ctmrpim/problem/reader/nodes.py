@@ -15,7 +15,16 @@ def read_nodes(values: Values) -> NodeSpec:
         raise ProblemError("missing section [nodes] (grid = [nx, ny], spacing = h or file = ...)", key="nodes")
     return NodeSpec(grid=_grid(table["grid"], values) if "grid" in table else None,
                     spacing=values.number(table["spacing"], "nodes.spacing") if "spacing" in table else None,
-                    file=str(table["file"]) if "file" in table else None)
+                    file=str(table["file"]) if "file" in table else None,
+                    jitter=values.number(table["jitter"], "nodes.jitter") if "jitter" in table else 0.0,
+                    seed=_seed(table["seed"], values) if "seed" in table else None)
+
+
+def _seed(value: Any, values: Values) -> int:
+    n = values.number(value, "nodes.seed")
+    if not (float(n).is_integer() and n >= 0):
+        raise ProblemError(f"{value!r} must be an integer >= 0", key="nodes.seed")
+    return int(n)
 
 
 def _grid(value: Any, values: Values) -> tuple[int, int]:

@@ -7,6 +7,9 @@ import tomllib
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.reader.keys import LIST_SECTIONS, SECTIONS
 
+#: the keys of [nodes] that say where the nodes are (exactly one is given)
+PLACEMENTS = ("grid", "spacing", "file")
+
 
 def apply_overrides(raw: dict, overrides: list[str]) -> dict:
     """``section.key=value`` settings (value in TOML syntax, else a string) applied to a raw file."""
@@ -25,7 +28,8 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
                 raise ProblemError(f"--set {item!r}: the value is not valid TOML ({exc})") from None
             parsed = value.strip()
         table = raw.setdefault(section, {})
-        if section == "nodes":  # grid, spacing and file exclude each other: the new one replaces
-            table.clear()
+        if section == "nodes" and key in PLACEMENTS:  # grid, spacing and file exclude each other: the new one replaces
+            for other in PLACEMENTS:
+                table.pop(other, None)
         table[key] = parsed
     return raw
