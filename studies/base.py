@@ -104,11 +104,11 @@ def finished(fig: Figure, axes: np.ndarray, which: str = "major", fontsize: int 
     return fig
 
 
-def new_figure(ncols: int = 1, width: float = 5.5) -> tuple[Figure, np.ndarray]:
-    """A new figure (Agg backend) with one row of ``ncols`` axes, each ``width`` x 4 inches: (figure, axes
-    (1, ncols))."""
+def new_figure(ncols: int = 1, width: float = 5.5, nrows: int = 1) -> tuple[Figure, np.ndarray]:
+    """A new figure (Agg backend) with ``nrows`` rows of ``ncols`` axes, each ``width`` x 4 inches: (figure, axes
+    (nrows, ncols))."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    return plt.subplots(1, ncols, figsize=(width * ncols, 4), squeeze=False)
+    return plt.subplots(nrows, ncols, figsize=(width * ncols, 4 * nrows), squeeze=False)

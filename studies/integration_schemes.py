@@ -3,9 +3,11 @@ the default of linear analyses), background cells clipped by the boundary ("cell
 conforming nodal integration ("scni"), each at a few integration densities, on the same nodes, boundary,
 RPIM and assembly. The paper's claim is that CTM avoids background cells' inconsistency without the cost
 of high-order Gauss rules; this measures it: the cantilever's errors against integration points and against
-wall time (a Pareto figure), the plate with a hole's stress concentration, and the constant-stress patch
-test on a plate with a square hole. The table condenses it per setting: the patch-test error, the
-fitted energy-error rate and the wall time to 0.1 % energy error on the cantilever.
+wall time (a Pareto figure), the same cantilever on jittered clouds (every interior node moved by up to 0.3
+of the spacing), the manufactured solution (a smooth field with a body force on a plate with a hole and a
+curved end), the plate with a hole's stress concentration, and the constant-stress patch test on a plate with
+a square hole. The table condenses it per setting: the patch-test error, the fitted energy-error rates and
+the wall time to 0.1 % energy error on the cantilever.
 """
 from __future__ import annotations
 
@@ -42,16 +44,26 @@ SETTINGS = {
 QUICK_SETTINGS = list(SETTINGS)[:4]
 GRIDS = ([(17, 5), (33, 9), (65, 17)], [(17, 5), (33, 9), (65, 17), (129, 33)])
 SPACINGS = ([0.5, 0.25], [0.5, 0.25, 0.125])
+MANUFACTURED_SPACINGS = ([0.1, 0.05], [0.1, 0.05, 0.025])
+JITTER = 0.3    # of the spacing: the jittered cantilever's clouds (seed 0)
 TARGET = 1e-3   # energy error the time is measured to
 
 
 def specs(quick: bool) -> list[CaseSpec]:
-    """Every setting on the cantilever's grids, the plate with a hole's spacings and the patch test."""
+    """Every setting on the cantilever's grids (regular and jittered), the manufactured solution's and the plate
+    with a hole's spacings, and the patch test."""
     settings = QUICK_SETTINGS if quick else list(SETTINGS)
     k = 0 if quick else 1
     out = [CaseSpec("cantilever", (f"nodes.grid=[{nx}, {ny}]", *SETTINGS[s]),
                     labels=(("problem", "cantilever"), ("setting", s), ("size", f"{nx} x {ny}"), ("h", 48 / (nx - 1))))
            for s in settings for nx, ny in GRIDS[k]]
+    out += [CaseSpec("cantilever", (f"nodes.grid=[{nx}, {ny}]", f"nodes.jitter={JITTER}", *SETTINGS[s]),
+                     labels=(("problem", "cantilever-jittered"), ("setting", s), ("size", f"{nx} x {ny}"),
+                             ("h", 48 / (nx - 1))))
+            for s in settings for nx, ny in GRIDS[k]]
+    out += [CaseSpec("manufactured", (f"nodes.spacing={h}", *SETTINGS[s]),
+                     labels=(("problem", "manufactured"), ("setting", s), ("size", f"h = {h}"), ("h", h)))
+            for s in settings for h in MANUFACTURED_SPACINGS[k]]
     out += [CaseSpec("plate-hole", (f"nodes.spacing={h}", *SETTINGS[s]),
                      labels=(("problem", "plate-hole"), ("setting", s), ("size", f"h = {h}"), ("h", h)))
             for s in settings for h in SPACINGS[k]]
@@ -70,34 +82,57 @@ def extra(summary: dict) -> dict:
 
 def scheme_table(df: pd.DataFrame) -> pd.DataFrame:
     """Per setting: the patch test's larger error (L2, energy), the cantilever's fitted energy-error rate and
-    finest energy error, and the wall time to 0.1 % energy error (interpolated, NaN where no grid reached it)."""
+    finest energy error, the wall time to 0.1 % energy error (interpolated, NaN where no grid reached it), and
+    the fitted energy-error rates and finest errors of the jittered cantilever and the manufactured solution."""
     ok = df[df.status == "ok"]
     rows = []
     for setting, d in ok.groupby("setting", sort=False):
         beam = d[d.problem == "cantilever"].sort_values("nodes")
+        jittered = d[d.problem == "cantilever-jittered"].sort_values("nodes")
+        smooth = d[d.problem == "manufactured"].sort_values("nodes")
         patch = d[d.problem == "patch"]
         rows.append({
             "setting": setting,
             "patch_error": float(patch[["l2_error", "energy_error"]].max(axis=1).iloc[0]) if len(patch) else np.nan,
-            "energy_rate": fitted_rate(beam.h, beam.energy_error) if len(beam) > 1 else np.nan,
-            "finest_energy_error": float(beam.energy_error.iloc[-1]) if len(beam) else np.nan,
+            "energy_rate": _rate(beam),
+            "finest_energy_error": _finest(beam),
             "points_finest": int(beam.integration_points.iloc[-1]) if len(beam) else 0,
             "time_to_0.1%_energy_s": (time_to_reach(beam[["nodes", "time_s"]].assign(tip_error=beam.energy_error),
                                                     TARGET) if len(beam) else np.nan),
+            "jittered_energy_rate": _rate(jittered),
+            "jittered_finest_energy_error": _finest(jittered),
+            "manufactured_energy_rate": _rate(smooth),
+            "manufactured_finest_energy_error": _finest(smooth),
         })
     return pd.DataFrame(rows)
 
 
+def _rate(rows: pd.DataFrame) -> float:
+    """The fitted energy-error rate in h of ``rows`` (sorted by nodes); NaN with fewer than two."""
+    return fitted_rate(rows.h, rows.energy_error) if len(rows) > 1 else np.nan
+
+
+def _finest(rows: pd.DataFrame) -> float:
+    """The energy error of the finest of ``rows`` (sorted by nodes); NaN without any."""
+    return float(rows.energy_error.iloc[-1]) if len(rows) else np.nan
+
+
 def figure(df: pd.DataFrame) -> Figure:
-    """Cantilever energy error against integration points and against wall time; plate-hole stress
-    concentration against nodes."""
-    fig, axes = new_figure(3, 7.0)
+    """Cantilever energy error against integration points and against wall time, plate-hole stress concentration
+    against nodes; the jittered cantilever's and the manufactured solution's energy error, and the latter's L2
+    error, against h."""
+    fig, axes = new_figure(3, 6.0, nrows=2)
     ok = df[df.status == "ok"]
     for setting, d in ok[ok.problem == "cantilever"].groupby("setting", sort=False):
         d = d.sort_values("nodes")
         style = "o-" if setting in QUICK_SETTINGS else ".--"
         axes[0, 0].loglog(d.integration_points, 100 * d.energy_error, style, label=setting)
         axes[0, 1].loglog(d.time_s, 100 * d.energy_error, style, label=setting)
+    for ax, problem, error in ((axes[1, 0], "cantilever-jittered", "energy_error"),
+                               (axes[1, 1], "manufactured", "energy_error"), (axes[1, 2], "manufactured", "l2_error")):
+        for setting, d in ok[ok.problem == problem].groupby("setting", sort=False):
+            d = d.sort_values("h")
+            ax.loglog(d.h, 100 * d[error], "o-" if setting in QUICK_SETTINGS else ".--", label=setting)
     for setting, d in ok[ok.problem == "plate-hole"].groupby("setting", sort=False):
         d = d.sort_values("nodes")
         axes[0, 2].semilogx(d.nodes, d.sxx_hole_top / 1000.0, "o-" if setting in QUICK_SETTINGS else ".--",
@@ -107,6 +142,10 @@ def figure(df: pd.DataFrame) -> Figure:
     axes[0, 1].set(xlabel="wall time per solve, one core [s]", ylabel="energy-norm error [%]",
                    title="Cantilever: error vs time")
     axes[0, 2].set(xlabel="nodes", ylabel="sxx(0, a) / T", title="Plate with a hole: stress concentration")
+    axes[1, 0].set(xlabel="node spacing h (problem length unit)", ylabel="energy-norm error [%]",
+                   title=f"Cantilever, nodes jittered by {JITTER:g} h")
+    axes[1, 1].set(xlabel="node spacing h (problem length unit)", ylabel="energy-norm error [%]", title="Manufactured solution")
+    axes[1, 2].set(xlabel="node spacing h (problem length unit)", ylabel="L2 displacement error [%]", title="Manufactured solution")
     return finished(fig, axes, "both", 6)
 
 

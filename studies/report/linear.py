@@ -103,6 +103,10 @@ def write_integration_schemes(w: Writer, df: pd.DataFrame, table: pd.DataFrame) 
         patch_error=table.patch_error.map(lambda v: f"{v:.1e}"),
         energy_rate=table.energy_rate.map(lambda v: f"{v:.2f}"),
         finest_energy_error=table.finest_energy_error.map(lambda v: f"{100 * v:.3g} %"),
+        jittered_energy_rate=table.jittered_energy_rate.map(lambda v: f"{v:.2f}"),
+        jittered_finest_energy_error=table.jittered_finest_energy_error.map(lambda v: f"{100 * v:.3g} %"),
+        manufactured_energy_rate=table.manufactured_energy_rate.map(lambda v: f"{v:.2f}"),
+        manufactured_finest_energy_error=table.manufactured_finest_energy_error.map(lambda v: f"{100 * v:.3g} %"),
         **{"time_to_0.1%_energy_s": table["time_to_0.1%_energy_s"].map(lambda v: "not reached" if np.isnan(v)
                                                                          else f"{v:.3f} s")})
     w(md(shown))
@@ -119,6 +123,12 @@ def write_integration_schemes(w: Writer, df: pd.DataFrame, table: pd.DataFrame) 
           "; no other setting reaches it on these grids.\n\n")
     else:
         w("No setting reaches 0.1 % energy error on these grids.\n\n")
+    for problem, name in (("jittered", "the jittered cantilever"), ("manufactured", "the manufactured solution")):
+        finest = t[f"{problem}_finest_energy_error"].dropna().sort_values()
+        if len(finest):
+            rate = t[f"{problem}_energy_rate"]
+            w(f"On {name}, finest energy error: " + ", ".join(
+                f"{s} {100 * v:.3g} % (rate {rate[s]:.2f})" for s, v in finest.items()) + ".\n\n")
     ok = df[(df.status == "ok") & (df.problem == "plate-hole")]
     if len(ok):
         finest = ok[ok.h == ok.h.min()].set_index("setting")

@@ -74,5 +74,6 @@ def test_integration_schemes_table(tables) -> None:
     check("patch-linear-scni", t.loc["scni (1 per node)", "patch_error"])
     check("cantilever-vci-energy-rate", t.loc["ctm-vci (1/3, 1 pt)", "energy_rate"])
     check("cantilever-scni-energy-rate", t.loc["scni (1 per node)", "energy_rate"])
+    check("cantilever-jittered-vci-energy-rate", t.loc["ctm-vci (1/3, 1 pt)", "jittered_energy_rate"])
     # the paper's CTM and background cells are not consistent: their patch tests fail by 1e-3 or more
     assert (t.loc[["ctm (1/3, 1 pt)", "cell-gauss (d_c, 2x2)"], "patch_error"] > 1e-3).all()
