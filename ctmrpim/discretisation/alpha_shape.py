@@ -148,7 +148,8 @@ def carried_boundary(points: np.ndarray, triangles: np.ndarray, reference: np.nd
     if not np.all(now > MIN_CARRIED_AREA * ref) or not np.all(circumradii(points, triangles) < alpha):
         return None
     loops = _loops(points, triangles)
-    rings = shapely.multilinestrings([points[np.r_[lp, lp[:1]]] for lp in loops])
+    # one geometry per loop first: loops of different lengths make no rectangular coordinate array
+    rings = shapely.MultiLineString([points[np.r_[lp, lp[:1]]] for lp in loops])
     if not shapely.is_simple(rings):
         return None
     used = np.zeros(len(points), bool)

@@ -17,6 +17,14 @@ written without a rebuild. The stress update is objective (:mod:`ctmrpim.materia
 Winget rotation for the rate form of linear elasticity, the left Cauchy-Green tensor for neo-
 Hookean) and the tangent its exact derivative (complex steps), geometric part included.
 
+With ``method.integration = "ctm-vci"`` every configuration gets the corrected test gradients of its own
+points and tracked boundary (:mod:`ctmrpim.discretisation.consistent_integration`: the integration constraints
+hold on x_n, where F_int is integrated), so F_int = G~_n^T (w_n P_n) and K = G~_n^T diag(w_n A) G_n (Petrov-
+Galerkin), and the Dirichlet consistency term on constrained edges with the traction P_n n_n of the stress
+recovered at the boundary's Gauss points from the points' (the state lives at the points only; the same
+answer as the small-strain Mohr-Coulomb path gives: :class:`~ctmrpim.discretisation.consistent_integration.
+RecoveredDirichletTerm`). Where a rebuild is skipped the correction is redone on the carried configuration.
+
 Where state lives (docs/design.md, 'State under re-tracking'): at the integration points. On a rebuild it
 is L2-projected onto the nodes over the old points and evaluated at the new points
 (:mod:`ctmrpim.discretisation.state_transfer`); the number of transfers is reported. After the last
@@ -39,12 +47,14 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from ctmrpim.discretisation import assembly
+from ctmrpim.discretisation import assembly, consistent_integration
 from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape, carried_boundary
 from ctmrpim.discretisation.boundary_loads import BoundaryLoads
 from ctmrpim.discretisation.configuration import BoundaryTags, boundary_tags, build, lay_points, reference_cloud
+from ctmrpim.discretisation.lagrangian_operators import gradient_operator
 from ctmrpim.discretisation.rpim import ShapeFunctions
 from ctmrpim.discretisation.state_transfer import project_to_nodes, transfer
+from ctmrpim.discretisation.stress_recovery import recovery_operator
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.linear_elastic import LinearElastic
 from ctmrpim.materials.neo_hookean import NeoHookean
@@ -113,7 +123,7 @@ class AdaptiveBody:
     def __init__(self, case: Case, X: np.ndarray, lengths: ScaledMethod,
                  update: HypoelasticUpdate | LeftCauchyGreenUpdate, traction: TractionTags,
                  material_points: np.ndarray, point_forces: np.ndarray, timer: Timer,
-                 reference_triangles: np.ndarray) -> None:
+                 reference_triangles: np.ndarray, fixed: np.ndarray | None = None) -> None:
         self.case, self.X, self.lengths, self.update, self.traction, self.timer = (case, X, lengths, update, traction,
                                                                                  timer)
         self.reference_triangles = reference_triangles   # the reference boundary's (corners kept)
@@ -130,6 +140,8 @@ class AdaptiveBody:
         self.skipped_rebuilds = 0
         self.areas: list[float] = []
         self.regeneration = case.method.point_regeneration
+        self.fixed = np.zeros(0, int) if fixed is None else fixed       # constrained dofs (the Dirichlet term's)
+        self.dirichlet: consistent_integration.RecoveredDirichletTerm | None = None
         self._build()
         self.state = update.initial(len(self.w))
         self.nodal_state = update.initial(len(X))
@@ -208,10 +220,27 @@ class AdaptiveBody:
         self.loads = BoundaryLoads(Nt, tr.weights, tr.tx, tr.ty, tr.turn_ends, tr.follower, tr.d0, F_points)
         self.timer.lap("shape_functions")
 
-    def _set_gradient(self) -> None:
-        """G of the current configuration and its transpose, kept across the Newton iterations."""
+    def _set_gradient(self, carried: bool = False) -> None:
+        """G of the current configuration and the transpose of the test gradients' (G^T, or with ``ctm-vci`` that
+        of the corrected ones, with the Dirichlet term), kept across the Newton iterations. A ``carried``
+        configuration (moved without a rebuild) keeps its shape functions, so the values at the boundary's Gauss
+        points are those computed where the points were before the move."""
         self.G = self.conf.block_gradient()
         self.GT = self.G.T
+        if self.case.method.integration != "ctm-vci":
+            return
+        conf = self.conf
+        boundary = consistent_integration.boundary_quadrature(conf.x, conf.boundary.edges)
+        if not carried:
+            self.N_boundary = conf.shape_functions_at(boundary.points, derivatives=False).N
+        test_dx, test_dy = consistent_integration.corrected_gradients(
+            conf.x, self.lengths.d_c, conf.points, conf.w / self.thickness, conf.sf, boundary, self.N_boundary,
+            self.case.method.correction)
+        self.GT = gradient_operator(test_dx, test_dy).T.tobsr()
+        R = recovery_operator(boundary.points, conf.points, conf.w, self.lengths.d_c)
+        term = consistent_integration.RecoveredDirichletTerm(len(self.x), self.fixed, boundary, self.N_boundary, R,
+                                                             self.thickness)
+        self.dirichlet = term if term.active else None
 
     @property
     def boundary(self) -> Boundary:
@@ -248,7 +277,11 @@ class AdaptiveBody:
         A = complex_step_tangent(self.update, f, self.state)
         f_ext, K_load = self.loads.forces(self.x + du.reshape(-1, 2), factor)
         K = tangent(self.G, A, self.w, self.GT)
-        return f_ext, internal_force(self.G, P, self.w, self.GT), (K if K_load is None else K + K_load)
+        f_int = internal_force(self.G, P, self.w, self.GT)
+        if self.dirichlet is not None:    # ctm-vci: the traction of the recovered stress on constrained edges
+            f_int = f_int - self.dirichlet.force(P.reshape(-1, 4))
+            K = K - self.dirichlet.stiffness(self.G, A)
+        return f_ext, f_int, (K if K_load is None else K + K_load)
 
     def commit(self, U: np.ndarray, rebuild: bool = True) -> str | None:
         """Accept the increment: advance the state, move nodes and points, re-track, rebuild.
@@ -294,7 +327,7 @@ class AdaptiveBody:
                 return None
         self.state, self.strained = state, strained
         self.conf = self.conf.carried(self.x, moved, w_moved, f)
-        self._set_gradient()
+        self._set_gradient(carried=True)
         self.nodal_state = project_to_nodes(N_old, w_moved, state)
         self.skipped_rebuilds += skipped is not None
         self.timer.lap("transfer")
@@ -356,7 +389,7 @@ def adaptive_body(case: Case, timer: Timer | None = None) -> tuple[AdaptiveBody,
     loads_X = np.array([[p.x, p.y] for p in problem.point_loads]).reshape(-1, 2)
     forces = np.array([[p.fx, p.fy] for p in problem.point_loads]).reshape(-1, 2)
     body = AdaptiveBody(case, cloud.nodes, cloud.lengths, update, _traction_tags(cloud.nodes, tags, problem.thickness),
-                        np.r_[probes_X, loads_X], forces, timer, cloud.boundary.triangles)
+                        np.r_[probes_X, loads_X], forces, timer, cloud.boundary.triangles, tags.fixed)
     return body, tags
 
 

@@ -102,3 +102,19 @@ def test_alpha_too_small_keeps_nothing() -> None:
     x, y = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 5))
     with pytest.raises(ProblemError, match="keeps no triangle"):
         alpha_shape(np.c_[x.ravel(), y.ravel()], 0.01, 0.25)
+
+
+@pytest.mark.parametrize("name", list(GEOMETRIES))
+def test_carried_boundary_keeps_every_loop_under_a_rigid_rotation(name: str) -> None:
+    """The reference triangulation carried through a rotation by 60 degrees keeps its loops (a hole's too: loops of
+    different lengths) node for node."""
+    from ctmrpim.discretisation.alpha_shape import carried_boundary
+
+    _, nodes, d_c = cloud(name)
+    reference = alpha_shape(nodes, 1.5 * d_c, d_c)
+    c, s = np.cos(np.pi / 3), np.sin(np.pi / 3)
+    moved = nodes @ np.array([[c, s], [-s, c]])
+    carried = carried_boundary(moved, reference.triangles, nodes, 1.5 * d_c)
+    assert carried is not None and len(carried.loops) == HOLES[name] + 1
+    assert sorted(map(sorted, carried.loops)) == sorted(map(sorted, reference.loops))
+    assert carried.area == pytest.approx(reference.area, rel=1e-12)
