@@ -7,21 +7,29 @@ is a function that adds its subcommands to the parser (the verification suite in
 
 Exit status: 0 done; 2 bad input (a bad problem file, an unknown benchmark, a selector that matches
 nothing: one line on stderr naming the file, key and reason, no traceback, and nothing written); 3 the solve
-did not converge (one line; ``summary.json`` holds the history up to there and ``status.json`` says "not
-converged"); 130 interrupted (Ctrl-C: ``status.json`` says "interrupted", no traceback). The output folder
-holds one run, with its status record (:mod:`ctmrpim.io.run_folder`); while a solve runs, its phases and
-steps are shown on stderr (:mod:`ctmrpim.progress`; ``--quiet`` silences them).
+did not converge (Newton gave up, dynamic relaxation diverged or did not come to rest, an explicit run
+diverged: one line; ``summary.json`` holds the history up to there and ``status.json`` says "not
+converged"); 130 interrupted (Ctrl-C) and 143 terminated (SIGTERM): ``status.json`` says "interrupted", no
+traceback, no half-written file. The output folder holds one run, with its status record
+(:mod:`ctmrpim.io.run_folder`); while a solve runs, its phases and steps are shown on stderr
+(:mod:`ctmrpim.progress`; ``--quiet`` silences them). Every warning printed (``ctmrpim: warning: ...``, one
+line) is also in the summary's ``notes``.
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import os
 import shlex
+import signal
 import sys
+import threading
 import time
 import warnings
 from importlib.metadata import entry_points
 from pathlib import Path
+from typing import Iterator
 
 import ctmrpim.benchmarks as benchmarks
 import ctmrpim.methods as methods
@@ -30,11 +38,49 @@ from ctmrpim.cases import load_case
 from ctmrpim.errors import ConvergenceError, ProblemError
 from ctmrpim.io.run_folder import RunFolder, default_folder
 from ctmrpim.problem.case import Case
+from ctmrpim.problem.reader.effects import check_solver_effects, given_keys
 from ctmrpim.result import Result
+from ctmrpim.solvers.dynamic_relaxation import not_at_rest
 from ctmrpim.version import __version__
 
 #: entry-point group of commands that applications add to ``ctmrpim``
 COMMANDS = "ctmrpim.commands"
+#: exit status of a run interrupted by Ctrl-C (SIGINT), and of one stopped by SIGTERM (128 + the signal's
+#: number, as a shell reports a process the signal killed)
+INTERRUPTED = 130
+TERMINATED = 128 + signal.SIGTERM
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, a batch system's time limit), raised in the main thread like Ctrl-C's
+    KeyboardInterrupt, so that a run stopped either way ends the same: its status record says "interrupted",
+    the writes under way are undone (every file is written under a temporary name and renamed when
+    complete), an explicit run's checkpoint stays for ``--resume``."""
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """Within the ``with`` block SIGTERM raises :class:`Terminated` in this process (from the main thread
+    only, where Python runs signal handlers; elsewhere nothing changes). A process forked inside (a sweep's
+    workers) still dies of SIGTERM as it would have, and a second SIGTERM does not cut the clean-up short."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    owner = os.getpid()
+
+    def handler(signum: int, frame: object) -> None:
+        if os.getpid() != owner:     # a forked worker: the default action, as if no handler were installed
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
+        signal.signal(signum, signal.SIG_IGN)
+        raise Terminated
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
 def describe(result: Result, case: Case) -> str:
@@ -167,6 +213,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise ProblemError("--out '' names no folder: give a folder, or leave --out out for the default", key="--out")
     case = load_case(args.target, args.set or [])
     element = methods.element_of(methods.get(args.solver), args.element)
+    try:
+        check_solver_effects(given_keys("method", case.resolved, case.defaults), _set_keys(args.set, "method"),
+                             args.solver)
+    except ProblemError as exc:
+        raise exc.at(source=case.source) from None
     suffix = "" if args.solver == methods.DEFAULT else f"-{args.solver}" + (f"-{element}" if element else "")
     out = Path(args.out) if args.out else default_folder(args.target, case, args.target in benchmarks.names(),
                                                          suffix)
@@ -175,7 +226,7 @@ def cmd_run(args: argparse.Namespace) -> int:
                            f"{case.problem.analysis!r}", key="--resume")
     method = args.solver + (f"-{element}" if element else "")
     folder = RunFolder(out, command=shlex.join(["ctmrpim", *args.argv]), source=case.source, method=method,
-                       resume=args.resume)
+                       resume=args.resume, notes=args.notes)
     folder.start()
     reporter = progress.SILENT if args.quiet else progress.Progress(title=_title(case, method), name=case.problem.name)
     try:
@@ -183,6 +234,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             levels = None if args.quiet else (lambda level: reporter.line("  " + _level_line(level.record())))
             result = methods.solve(case, args.solver, args.element, progress=levels, out=out, resume=args.resume,
                                    progress_bar=not args.quiet)
+            if (unsettled := not_at_rest(result.outcome, result.history, case.relaxation)) is not None:
+                raise unsettled      # a relaxation that never came to rest has not found the static answer
             start = time.perf_counter()
             paths = folder.write_result(result, case)
             reporter.phase("output", time.perf_counter() - start)
@@ -195,8 +248,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     except ProblemError as exc:  # raised while solving, e.g. a selector that matches no node: name the file
         folder.discard()
         raise exc.at(source=case.source) from None
-    except KeyboardInterrupt:
-        folder.finish("interrupted", 130, error="interrupted")
+    except KeyboardInterrupt as exc:     # Ctrl-C, or SIGTERM (Terminated)
+        terminated = isinstance(exc, Terminated)
+        folder.finish("interrupted", TERMINATED if terminated else INTERRUPTED,
+                      error="terminated (SIGTERM)" if terminated else "interrupted")
         raise
     except BaseException as exc:     # a bug: the record says so, the traceback follows
         folder.finish("failed", 1, error=f"{type(exc).__name__}: {exc}")
@@ -207,6 +262,13 @@ def cmd_run(args: argparse.Namespace) -> int:
         steps = len(paths) - len(shown)
         print("  wrote " + ", ".join(str(p) for p in shown) + (f" ({steps} increments in series/)" if steps else ""))
     return 0
+
+
+def _set_keys(overrides: list[str] | None, section: str) -> list[str]:
+    """The keys of ``section`` that ``--set section.key=value`` items set (malformed ones were refused when
+    the case was read)."""
+    dotted = (item.partition("=")[0].partition(".") for item in overrides or [])
+    return [key.strip() for name, _, key in dotted if name.strip() == section]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -236,16 +298,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line on ``argv`` (default ``sys.argv[1:]``); exit status 0, 2 on a ProblemError, 3 when a
-    solve did not converge, 130 when interrupted."""
+    solve did not converge, 130 when interrupted (Ctrl-C), 143 when terminated (SIGTERM)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
     args.argv = argv
+    args.notes = []      # every warning shown, for the summary's notes
     with warnings.catch_warnings():
         warnings.simplefilter("always", UserWarning)
         library_show = warnings.showwarning
 
         def show(message, category, *rest, **kw):
             if issubclass(category, UserWarning):  # ctmrpim's own advice to the user: one plain line
+                if str(message) not in args.notes:
+                    args.notes.append(str(message))
                 reporter = progress.current()
                 if isinstance(reporter, progress.Progress) and reporter.live:   # not through the live line
                     reporter.line(f"ctmrpim: warning: {message}")
@@ -256,13 +321,17 @@ def main(argv: list[str] | None = None) -> int:
 
         warnings.showwarning = show
         try:
-            return args.func(args)
+            with sigterm_as_interrupt():
+                return args.func(args)
         except ProblemError as exc:  # the promised single line, even if a library's text held a newline
             print(f"ctmrpim: error: {' '.join(exc.message.splitlines())}", file=sys.stderr)
             return 2
+        except Terminated:
+            print("ctmrpim: terminated (SIGTERM)", file=sys.stderr)
+            return TERMINATED
         except KeyboardInterrupt:
             print("ctmrpim: interrupted", file=sys.stderr)
-            return 130
+            return INTERRUPTED
 
 
 if __name__ == "__main__":

@@ -6,8 +6,10 @@ command line installed one, so the Python API, the studies and the tests print n
 
 - every :meth:`ctmrpim.timing.Timer.lap` (boundary, integration points, shape functions, assembly, solve,
   postprocessing; the command line adds output): :meth:`Progress.phase`;
-- loops that go on for long (Newton's increments, the explicit solver's steps): :meth:`Progress.status`, a
-  line saying where the loop is, which replaces the previous one (an empty one when the loop is over);
+- loops that go on for long (Newton's increments and iterations, dynamic relaxation's steps, the explicit
+  solver's steps): :meth:`Progress.status`, a line saying where the loop is, which replaces the previous one
+  (an empty one when the loop is over); a loop run within a larger one (a strength-reduction level's Newton
+  iterations) is labelled by :meth:`Progress.stage`;
 - results worth keeping on screen (a strength-reduction level): :meth:`Progress.line`.
 
 On a terminal it keeps one live line, rewritten in place (a carriage return and erase-line) and ticking
@@ -63,6 +65,10 @@ class Silent:
     def line(self, text: str) -> None:
         """Ignore a line."""
 
+    def stage(self, label: str) -> contextlib.AbstractContextManager[None]:
+        """Nothing to label: a context that does nothing."""
+        return contextlib.nullcontext()
+
     def close(self) -> None:
         """Nothing to close."""
 
@@ -73,18 +79,19 @@ class Progress(Silent):
     ``live`` forces one behaviour (default: whether ``stream`` is a terminal); ``title`` names the run
     (problem, analysis, method, nodes) in the first log line, ``name`` (default ``title``) at the start of
     the live line, where the width is short; ``delay`` (default :data:`DELAY`, :data:`LIVE_DELAY` on a
-    terminal) is how long a run goes before anything is shown; ``log_interval`` the least time between a
-    log's status lines."""
+    terminal) is how long a run goes before anything is shown; ``log_interval`` (default
+    :data:`LOG_INTERVAL`) the least time between a log's status lines."""
 
     def __init__(self, stream: TextIO | None = None, *, live: bool | None = None, title: str = "", name: str = "",
-                 delay: float | None = None, log_interval: float = LOG_INTERVAL) -> None:
+                 delay: float | None = None, log_interval: float | None = None) -> None:
         self.stream = sys.stderr if stream is None else stream
         if live is None:
             isatty = getattr(self.stream, "isatty", None)
             live = bool(isatty and isatty())
         self.live, self.title, self.name = live, title, name or title
         self.delay = (LIVE_DELAY if live else DELAY) if delay is None else delay
-        self.log_interval = log_interval
+        self.log_interval = LOG_INTERVAL if log_interval is None else log_interval
+        self.label = ""                          # the stage the statuses belong to (see stage)
         self.t0 = time.perf_counter()
         self.last: tuple[str, float, dict[str, int]] | None = None    # the last phase finished
         self.pending: dict[str, list] = {}      # log: phases finished since the last line: [seconds, laps, counts]
@@ -123,7 +130,7 @@ class Progress(Silent):
     def status(self, text: str) -> None:
         """Where a long loop is now (replaces the previous status); ``""`` when the loop is over, so that the
         phases after it are shown again."""
-        self.state = text
+        self.state = f"{self.label}: {text}" if self.label and text else text
         if not text:
             return
         if self.live:
@@ -131,7 +138,7 @@ class Progress(Silent):
             return
         now = self.elapsed()
         if now >= self.delay and now - self.last_line >= self.log_interval:
-            self._write_pending(text)
+            self._write_pending(self.state)
 
     def line(self, text: str) -> None:
         """A line to keep (a strength-reduction level), written at once whatever the delay."""
@@ -144,6 +151,16 @@ class Progress(Silent):
             self.stream.flush()
         if self.live:
             self._draw(force=True)
+
+    @contextlib.contextmanager
+    def stage(self, label: str) -> Iterator[None]:
+        """Label every status within the ``with`` block with ``label`` (``"SRF 1.3500"``: the loops that
+        report do not know the level they serve)."""
+        previous, self.label = self.label, label
+        try:
+            yield
+        finally:
+            self.label = previous
 
     def close(self) -> None:
         """The run is over: stop the clock, erase the live line; a log gets the phases it has not seen yet

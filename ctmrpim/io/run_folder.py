@@ -3,9 +3,9 @@
 What ``ctmrpim run`` writes into its folder:
 
 - ``status.json``, first: ``state`` "running", when it started, the command, the version, the process; at
-  the end the state becomes "ok", "not converged", "interrupted" or "failed" with the time it ended, the
-  exit status and the reason. A folder whose status still says "running" belongs to a run that is going
-  on, or one that was killed.
+  the end the state becomes "ok", "not converged", "interrupted" (Ctrl-C or SIGTERM) or "failed" with the
+  time it ended, the exit status and the reason. A folder whose status still says "running" belongs to a
+  run that is going on, or one that was killed outright (SIGKILL).
 - ``result.vtu``, the series (``result.pvd`` + ``series/step_*.vtu``), an explicit run's ``checkpoint.npz``,
   and ``summary.json`` last (:func:`write_outputs`, all or none). A run that did not converge writes a
   ``summary.json`` with ``status`` "not converged", the reason and the history up to there, and no result.
@@ -73,10 +73,18 @@ def run_files(folder: Path, resume: bool = False, status: bool = False) -> list[
     names = FILES + ((STATUS,) if status else ())
     found = [folder / n for n in names if n not in keep and (folder / n).is_file()]
     series = folder / SERIES
-    if series.is_dir():
-        found += [p for p in leftovers(series) if STEP.fullmatch(TEMPORARY.fullmatch(p.name)["name"])]
-        if SERIES not in keep:
-            found += sorted(p for p in series.iterdir() if STEP.fullmatch(p.name) and p.is_file())
+    if series.is_dir() and SERIES not in keep:
+        found += sorted(p for p in series.iterdir() if STEP.fullmatch(p.name) and p.is_file())
+    return found + temporaries(folder)
+
+
+def temporaries(folder: Path) -> list[Path]:
+    """The hidden temporary files (``.NAME.XXXXXXXX.tmp``) that writes of a run's files left in ``folder`` and
+    its series: a write that was stopped before it could remove its own."""
+    folder = Path(folder)
+    series = folder / SERIES
+    found = [p for p in leftovers(series) if STEP.fullmatch(TEMPORARY.fullmatch(p.name)["name"])] \
+        if series.is_dir() else []
     return found + leftovers(folder, FILES + (STATUS,))
 
 
@@ -116,11 +124,14 @@ def _now() -> str:
 class RunFolder:
     """The output folder of one ``ctmrpim run``: :meth:`start` it, then end it with :meth:`write_result`,
     :meth:`not_converged`, :meth:`finish` (interrupted, failed) or :meth:`discard` (bad input: nothing
-    written). ``command`` is the command line as typed, for the status record."""
+    written). ``command`` is the command line as typed, for the status record; ``notes`` (the warnings the run
+    printed, a list that may grow while it runs) go into the summary's ``notes``."""
 
-    def __init__(self, path: Path, *, command: str, source: str, method: str, resume: bool = False) -> None:
+    def __init__(self, path: Path, *, command: str, source: str, method: str, resume: bool = False,
+                 notes: list[str] | None = None) -> None:
         self.path = Path(path)
         self.command, self.source, self.method, self.resume = command, source, method, resume
+        self.notes = notes if notes is not None else []
         self.created = False
         self.previous: str | None = None     # --resume: the status record of the run it continues
         self.status: dict[str, Any] = {}
@@ -161,7 +172,10 @@ class RunFolder:
     def finish(self, state: str, exit_status: int, error: str | None = None,
                outputs: list[Path] | None = None) -> None:
         """Set the status record's ``state`` ("ok", "not converged", "interrupted", "failed") with the end time,
-        seconds, exit status, the reason and the files written."""
+        seconds, exit status, the reason and the files written. A temporary file that a write stopped by the
+        interrupt left (the signal came between creating it and the clean-up that guards it) is removed."""
+        for p in temporaries(self.path):
+            p.unlink(missing_ok=True)
         self.status.update(state=state, finished=_now(), seconds=round(time.perf_counter() - self.t0, 3),
                            exit_status=exit_status)
         if error is not None:
@@ -175,7 +189,7 @@ class RunFolder:
     def write_result(self, result: Result, case: Case) -> list[Path]:
         """Write the run's outputs (:func:`write_outputs`: result, series, summary last), then the status "ok";
         the paths written."""
-        paths = write_outputs(result, case, self.path)
+        paths = write_outputs(result, case, self.path, self.notes)
         # what the folder holds, not only what was written now: an explicit run wrote its series as it went
         self.finish("ok", 0, outputs=[p for p in run_files(self.path) if not p.name.startswith(".")])
         return paths
@@ -186,7 +200,8 @@ class RunFolder:
         and checkpoint) stays. The summary's path."""
         path = write_partial_summary(self.path, source=case.source, method=self.method, parameters=case.resolved,
                                      defaults=case.defaults, status="not converged", error=error.message,
-                                     history=error.history, seconds=time.perf_counter() - self.t0)
+                                     history=error.history, seconds=time.perf_counter() - self.t0,
+                                     notes=self.notes)
         kept = [p for p in run_files(self.path) if not p.name.startswith(".")]
         self.finish("not converged", 3, error=error.message, outputs=kept)
         return path
@@ -206,17 +221,17 @@ class RunFolder:
             (self.path / STATUS).unlink(missing_ok=True)
 
 
-def write_outputs(result: Result, case: Case, out: Path) -> list[Path]:
+def write_outputs(result: Result, case: Case, out: Path, notes: list[str] | None = None) -> list[Path]:
     """result.vtu, the increment series (result.pvd + series/*.vtu) where there is one, and
-    summary.json last; all or none (a folder this call created is removed again if a write fails, so
-    a failed run never leaves a half-written result behind)."""
+    summary.json last (with ``notes`` on the run); all or none (a folder this call created is removed again
+    if a write fails or the run is interrupted, so a failed run never leaves a half-written result behind)."""
     created = not out.exists()
     paths: list[Path] = []
     try:
         paths.append(write_vtu(result, out))
         for p in write_series(result, out):
             paths.append(p)
-        paths.append(write_summary(result, out, case.source))
+        paths.append(write_summary(result, out, case.source, notes or ()))
     except BaseException as exc:
         for p in paths:
             p.unlink(missing_ok=True)

@@ -3,14 +3,15 @@
 Every JSON file ctmrpim writes is strict JSON (``allow_nan=False``): a number that is not finite (a relative
 error whose exact reference is zero, 0/0 or x/0) is written as ``null``, and the summary's ``notes`` say
 which value was undefined and why, so that every JSON reader accepts the file and nobody mistakes the gap
-for a measured value.
+for a measured value. The ``notes`` also keep what the command line warned about during the run (``notes``
+of :func:`write_summary`).
 """
 from __future__ import annotations
 
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 import numpy as np
 
@@ -91,16 +92,24 @@ def _write(content: dict[str, Any], out_dir: Path) -> Path:
     return path
 
 
-def write_summary(result: Result, out_dir: Path, source: str) -> Path:
-    """Write ``out_dir/summary.json`` atomically (strict JSON, see the module); its path."""
-    return _write(summary_dict(result, source), out_dir)
+def write_summary(result: Result, out_dir: Path, source: str, notes: Iterable[str] = ()) -> Path:
+    """Write ``out_dir/summary.json`` atomically (strict JSON, see the module), with ``notes`` on the run (the
+    warnings it printed) first in its ``notes``; its path."""
+    return _write({**summary_dict(result, source), **_notes(notes)}, out_dir)
 
 
 def write_partial_summary(out_dir: Path, *, source: str, method: str, parameters: dict[str, Any],
                           defaults: list[str], status: str, error: str, history: list[dict[str, Any]],
-                          seconds: float) -> Path:
+                          seconds: float, notes: Iterable[str] = ()) -> Path:
     """Write the ``summary.json`` of a run that gave no result (``status`` "not converged"): the resolved
-    input, the reason, the ``history`` of what converged before it stopped and the seconds it ran; its path."""
+    input, the reason, the ``history`` of what converged before it stopped, the seconds it ran and ``notes``
+    on the run; its path."""
     return _write({"ctmrpim_version": __version__, "status": status, "error": error, "source": source,
                    "method": method, "parameters": parameters, "defaults_applied": defaults,
-                   "timings": {"total": seconds}, "history": history}, out_dir)
+                   "timings": {"total": seconds}, "history": history, **_notes(notes)}, out_dir)
+
+
+def _notes(notes: Iterable[str]) -> dict[str, list[str]]:
+    """``{"notes": [...]}`` if there are any, else nothing: a summary without notes has no such key."""
+    notes = list(notes)
+    return {"notes": notes} if notes else {}

@@ -9,7 +9,11 @@ m = SAFETY x sum_j |K_ij| over the rows of its two dofs in the elastic stiffness
 1983), which bounds omega_max dt by 2 / sqrt(2 SAFETY) < 2, so the scheme is stable whatever the cloud.
 The run is **at rest** when |F_ext - F_int| <= tolerance |F_ext|; a run still moving after ``steps``
 steps has **not come to rest**: the paper's failure criterion for the slope (its displacement grows
-without bound, Fig. 19a).
+without bound, Fig. 19a), a level's answer in a strength-reduction search; in an analysis of its own
+(``analysis = "dynamic"``) the static answer was not found, and the command line reports it as a solve that
+did not converge (:func:`not_at_rest`, exit status 3). A run whose forces stop being finite has diverged:
+a :class:`~ctmrpim.errors.ConvergenceError` with the history up to there, whichever analysis it serves.
+Each step is shown by the progress reporter (:mod:`ctmrpim.progress`).
 
 True explicit dynamics (density mass, real time step, no damping) is issue 7's; this module serves the
 stability problems of the paper (slope and footing), where the paper uses dynamic relaxation.
@@ -17,10 +21,12 @@ stability problems of the paper (slope and footing), where the paper uses dynami
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
-from ctmrpim.errors import ProblemError
+from ctmrpim import progress
+from ctmrpim.errors import ConvergenceError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.problem.settings import Relaxation
 
@@ -73,19 +79,47 @@ def relax(system, material: MohrCoulomb, load_factor: float, settings: Relaxatio
     v = np.zeros_like(U)
     history: list[dict] = []
     ratio = np.inf
-    for step in range(1, settings.steps + 1):
-        system.commit(material, U)
-        r = f_ext - system.internal_force()
-        r[system.fixed] = 0.0
-        ratio = float(np.linalg.norm(r)) / scale
-        if not np.isfinite(ratio):
-            raise ProblemError(f"dynamic relaxation diverged at step {step} (non-finite forces)")
-        at_rest = ratio <= settings.tolerance
-        if step % settings.record_every == 0 or at_rest or step == settings.steps:
-            history.append({"step": step, "max_displacement": max_displacement(U), "residual": ratio})
-        if at_rest:
-            return RelaxationPath(True, step, ratio, history)
-        v += (r - settings.damping * np.abs(r) * np.sign(v)) / mass
-        v[system.fixed] = 0.0
-        U = U + v
+    report = progress.current()
+    # a run that blows up is reported once, as divergence, not by numpy's overflow warnings on the way
+    with np.errstate(over="ignore", invalid="ignore"):
+        for step in range(1, settings.steps + 1):
+            system.commit(material, U)
+            r = f_ext - system.internal_force()
+            r[system.fixed] = 0.0
+            ratio = float(np.linalg.norm(r)) / scale
+            if not np.isfinite(ratio):
+                history.append({"step": step, "max_displacement": max_displacement(U), "residual": ratio,
+                                "note": "diverged: non-finite forces"})
+                report.status("")
+                raise ConvergenceError(f"dynamic relaxation diverged at step {step} (non-finite forces)",
+                                       key="dynamic", history=history)
+            report.status(f"dynamic relaxation: step {step}/{settings.steps}, out-of-balance force {ratio:.2e} "
+                          f"of the loads (at rest below {settings.tolerance:g})")
+            at_rest = ratio <= settings.tolerance
+            if step % settings.record_every == 0 or at_rest or step == settings.steps:
+                history.append({"step": step, "max_displacement": max_displacement(U), "residual": ratio})
+            if at_rest:
+                report.status("")
+                return RelaxationPath(True, step, ratio, history)
+            v += (r - settings.damping * np.abs(r) * np.sign(v)) / mass
+            v[system.fixed] = 0.0
+            U = U + v
+    report.status("")
     return RelaxationPath(False, settings.steps, ratio, history)
+
+
+def not_at_rest(outcome: dict[str, Any], history: list[dict], settings: Relaxation | None
+                ) -> ConvergenceError | None:
+    """The failure of a dynamic-relaxation analysis (its result's ``outcome`` and ``history``, solved with
+    ``settings``) that is not at rest after its steps, with the history, its last record marked; None for
+    a run at rest or another analysis. A strength-reduction level still moving is an answer, not this."""
+    relaxed = outcome.get("relaxation")
+    if relaxed is None or relaxed["at_rest"]:
+        return None
+    tolerance = f" = {settings.tolerance:g}" if settings is not None else ""
+    marked = [dict(h) for h in history]
+    if marked:
+        marked[-1]["note"] = "not at rest"
+    return ConvergenceError(f"dynamic relaxation did not come to rest in {relaxed['steps']} steps (out-of-balance "
+                            f"force {relaxed['residual']:.2e} of the loads, above dynamic.tolerance{tolerance}); "
+                            "raise dynamic.steps, or look for a mechanism", key="dynamic.steps", history=marked)

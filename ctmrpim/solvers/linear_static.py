@@ -81,14 +81,15 @@ def solve_ctmrpim(case: Case) -> Result:
     F += assembly.body_force_vector(sf.N, conf.w, problem)
     if problem.body_load is not None:
         F += assembly.load_vector(sf.N, conf.w, *problem.body_load.at(conf.points).T)
-    timer.lap("assembly")
+    # the counts that set the work of the solve, shown while it runs (the progress reporter)
+    timer.lap("assembly", integration_points=len(conf.w), dofs=K.shape[0], nonzeros=int(K.nnz))
 
     # K of the consistent schemes (their Dirichlet terms) is not symmetric: no Cholesky
     symmetric = scheme in ("ctm", "cell-gauss")
     U = solve_constrained(K, F, fixed, fixed_values, "superlu" if not symmetric and method.solver in ("auto", "banded")
                           else method.solver)
     u = U.reshape(-1, 2)
-    timer.lap("solve")
+    timer.lap("solve", free_dofs=K.shape[0] - len(fixed))
 
     # stresses are recovered from the integration points': a raw D B(x) u oscillates at boundaries
     point_stress = assembly.strain(sf.dNdx, sf.dNdy, u) @ D.T

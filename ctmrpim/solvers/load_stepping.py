@@ -13,10 +13,13 @@ material) is halved and retried, and the history says so, never silently; after 
 a cut-back step grows back towards 1/steps. When an increment cannot be cut back any further the solve
 gives up with a :class:`~ctmrpim.errors.ConvergenceError` carrying the history so far (the CLI writes it
 and exits with status 3), unless the caller asked for the failure as an answer (a limit load, a
-strength-reduction level). Each iteration is shown by the progress reporter (:mod:`ctmrpim.progress`).
+strength-reduction level). Each iteration is shown by the progress reporter (:mod:`ctmrpim.progress`):
+"increment 3/16 (load factor 0.1875), iteration 2, residual 1.2e-06 of the loads", the increments counted
+as converged ones plus those the current step still needs (so cut-backs raise the total).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -106,7 +109,7 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
     start_values = path.U[fixed].copy()
     factor, dfactor = 0.0, 1.0 / steps
     last_step, last_dfactor = None, 0.0
-    report = progress.current()
+    report, converged_increments = progress.current(), 0
     while factor < 1.0 - 1e-12:
         target = min(1.0, factor + dfactor)
         trial, converged, it = path.U.copy(), False, 0
@@ -125,8 +128,8 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
             residual = f_ext - f_int
             scale = max(ref, np.linalg.norm(f_int))   # reactions carry a displacement-driven load
             residual[fixed] = 0.0
-            report.status(f"load factor {target:.4g}: Newton iteration {it}, residual "
-                          f"{np.linalg.norm(residual) / scale:.2e} of the loads ({path.cutbacks} cut-back(s) so far)")
+            report.status(_iteration_status(converged_increments, factor, dfactor, target, it,
+                                            float(np.linalg.norm(residual)) / scale, path.cutbacks))
             du = solve(K, residual)
             if not np.all(np.isfinite(du)):
                 raise ProblemError("the tangent stiffness is singular: the constraints do not stop every "
@@ -164,5 +167,17 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
             dfactor = min(2.0 * dfactor, 1.0 / steps)
         path.history.append({"load_factor": factor, "converged": True, "iterations": it,
                              **on_converged(factor, path.U)})
+        converged_increments += 1
     report.status("")
     return path
+
+
+def _iteration_status(done: int, factor: float, dfactor: float, target: float, iteration: int, residual: float,
+                      cutbacks: int) -> str:
+    """Where Newton is, for the progress reporter: the increment (of those converged, ``done``, plus the ones
+    the step ``dfactor`` still needs from ``factor`` to 1), its ``target`` load factor, the iteration and the
+    ``residual`` relative to the loads."""
+    total = done + math.ceil((1.0 - factor) / dfactor - 1e-9)
+    text = (f"increment {done + 1}/{total} (load factor {target:.4g}), iteration {iteration}, "
+            f"residual {residual:.2e} of the loads")
+    return text + (f", {cutbacks} cut-back(s) so far" if cutbacks else "")

@@ -37,6 +37,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ctmrpim import progress as _progress
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.problem.case import Case
@@ -95,7 +96,8 @@ class Level:
 def _relax_level(system, relaxation: Relaxation, material: MohrCoulomb, srf: float, fixed_values=None) -> Level:
     """Dynamic relaxation from the committed state with ``material`` under the full loads."""
     timer = Timer()
-    path = relax(system, material, 1.0, relaxation, fixed_values)
+    with _progress.current().stage(f"SRF {srf:.4f}"):    # the relaxation's steps, labelled with the level
+        path = relax(system, material, 1.0, relaxation, fixed_values)
     history = [[h["step"], h["max_displacement"]] for h in path.history]
     seconds = timer.elapsed()
     growth = path.growth()
@@ -113,8 +115,9 @@ def _level(system, loading, material_at, load_at, srf_at: Callable[[float], floa
     at the sub-step that did not converge) and, for a failed level whose cut-back sub-steps got part of
     the way, the stable level reached (the system is left there)."""
     timer = Timer()
-    path = system.run(loading, material_at, load_at, lambda t, U: {}, fixed_values=fixed_values,
-                      stop_on_failure=True)
+    with _progress.current().stage(f"SRF {srf_at(1.0):.4f}"):   # Newton's increments, labelled with the level
+        path = system.run(loading, material_at, load_at, lambda t, U: {}, fixed_values=fixed_values,
+                          stop_on_failure=True)
     seconds = timer.elapsed()
     if path.failed_at is None:
         return Level(srf_at(1.0), True, path.newton_iterations, path.cutbacks, seconds, system.snapshot()), None

@@ -42,6 +42,14 @@ CASES = {
                                 ["method.correction", "read only by integration = \"ctm-vci\""]),
     "min-support-static": Case(BASE + "[method]\nmin_support = 12\n", ["method.min_support", "explicit dynamics"]),
     "empty-out": Case(BASE, ["--out", "names no folder"], args=["--out", ""], names_file=False),
+    # typed for this run: refused; the same keys in the file only get a warning (test_fem_warns_...)
+    "method-key-set-for-fem": Case(BASE, ["--set: method.eta has no effect on the finite-element solve",
+                                          "reads only method.match_tolerance of [method]", "remove --set method.eta"],
+                                   args=["--set", "method.eta=3"] + FE + ["q1"]),
+    "method-keys-set-for-fem": Case(BASE, ["--set: method.alpha, method.line_spacing have no effect",
+                                           "remove those --set"],
+                                    args=["--set", "method.alpha=2", "--set", "method.line_spacing=[0.5, 0.5]",
+                                          "--solver", "fem"]),
     "huge-grid": Case(edit("grid = [11, 3]", "grid = [100000, 100000]"),
                       ["nodes", "too large for this machine", "1e+10 nodes", "GiB of memory"]),
     "tiny-spacing": Case(edit("grid = [11, 3]", "spacing = 1e-5"), ["nodes", "too large for this machine"]),
@@ -71,4 +79,28 @@ def test_density_without_gravity_warns_and_runs(tmp_path: Path, capsys, monkeypa
     lines = out.stderr.splitlines()
     assert lines == ["ctmrpim: warning: material.density = 2000 has no effect in a linear analysis without "
                      "problem.gravity"]
-    assert json.loads((out.folder / "out" / "summary.json").read_text())["parameters"]["material"]["density"] == 2000
+    summary = json.loads((out.folder / "out" / "summary.json").read_text())
+    assert summary["parameters"]["material"]["density"] == 2000
+    assert summary["notes"] == [lines[0].removeprefix("ctmrpim: warning: ")]    # what was printed is kept
+
+
+def test_fem_warns_about_the_files_method_keys_and_notes_them(tmp_path: Path, capsys, monkeypatch) -> None:
+    """CTM-RPIM's [method] keys in the file (every benchmark has some) under --solver fem: one warning line
+    naming them, the run goes on, and the summary's notes say the same; match_tolerance, which the finite
+    elements read, is not named, and setting it with --set is accepted."""
+    toml = BASE + "[method]\neta = 3.0\nalpha = 2.0\nmatch_tolerance = 0.02\n"
+    out = _run(Case(toml, [], args=FE + ["q1", "--set", "method.match_tolerance=0.03"]), tmp_path / "case", capsys,
+               monkeypatch)
+    assert out.code == 0, out.stderr
+    warning = ("[method] eta, alpha have no effect on the finite-element solve (--solver fem reads only "
+               "method.match_tolerance of [method])")
+    assert out.stderr.splitlines() == [f"ctmrpim: warning: {warning}"]
+    summary = json.loads((out.folder / "out" / "summary.json").read_text())
+    assert summary["notes"] == [warning] and summary["method"] == "fem-q1"
+
+
+def test_ctm_rpim_reads_the_method_keys_and_says_nothing(tmp_path: Path, capsys, monkeypatch) -> None:
+    out = _run(Case(BASE + "[method]\neta = 3.0\n", [], args=["--set", "method.alpha=2"]), tmp_path / "case",
+               capsys, monkeypatch)
+    assert out.code == 0 and out.stderr == "", out.stderr
+    assert "notes" not in json.loads((out.folder / "out" / "summary.json").read_text())

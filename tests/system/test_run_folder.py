@@ -28,6 +28,13 @@ QUASI_STATIC = ["tip-load", "--set", "nodes.grid=[17,3]", "--set", "loading.step
 #: the same, Newton capped so that the third increment fails with no cut-back left
 NOT_CONVERGING = QUASI_STATIC + ["--set", "loading.max_cutbacks=0", "--set", "loading.max_iterations=8"]
 LINEAR = ["cantilever", "--set", "nodes.grid=[17,5]"]
+#: dynamic relaxation of a strong Mohr-Coulomb column under its own weight; 50 steps are too few to come to rest
+RELAXATION = ["self-weight", "--set", 'problem.analysis="dynamic"', "--set", 'material.model="mohr-coulomb"',
+              "--set", "material.c=1e9", "--set", "material.phi=30", "--set", "dynamic.steps=50",
+              "--set", "dynamic.record_every=20"]
+#: the explicit run the signal tests stop: it cannot come to rest before the signal (explicit.rest = 1e-12)
+EXPLICIT = ["column-collapse", "--set", "nodes.grid=[16,9]", "--set", "explicit.duration=5", "--set",
+            "explicit.checkpoint_every=20", "--set", "explicit.rest=1e-12"]
 #: a linear problem whose exact stresses are zero: its relative energy error is x/0
 SHIFT = """
 [problem]
@@ -163,6 +170,40 @@ def test_a_limit_load_is_an_answer_not_exit_3(tmp_path, capsys) -> None:
     assert s["limit_pressure"]["failed"] is not None
 
 
+@pytest.mark.filterwarnings(r"ignore:\[exact\] is not compared:UserWarning")
+def test_dynamic_relaxation_not_at_rest_exits_3(tmp_path, capsys) -> None:
+    """A relaxation still moving after its steps has not found the static answer: exit 3 like Newton giving
+    up, its history in the summary, the last record marked, no result."""
+    out = tmp_path / "out"
+    code, stdout, stderr = _run(capsys, "run", *RELAXATION, "--out", str(out), "--quiet")
+    assert code == 3 and stdout == "" and "Traceback" not in stderr
+    last = stderr.splitlines()[-1]
+    assert last.startswith("ctmrpim: not converged: ") and "dynamic.steps: dynamic relaxation did not come to rest " \
+        "in 50 steps" in last and "above dynamic.tolerance = 0.0001" in last
+    assert sorted(p.name for p in out.iterdir()) == ["status.json", "summary.json"]
+    summary, status = _json(out / "summary.json"), _json(out / "status.json")
+    assert summary["status"] == status["state"] == "not converged" and status["exit_status"] == 3
+    assert [h["step"] for h in summary["history"]] == [20, 40, 50] and summary["history"][-1]["note"] == "not at rest"
+    assert summary["notes"] == ["[exact] is not compared in a 'dynamic' analysis (only linear analyses report errors)"]
+
+
+@pytest.mark.filterwarnings(r"ignore:\[exact\] is not compared:UserWarning")
+def test_dynamic_relaxation_diverging_exits_3(tmp_path, capsys, monkeypatch) -> None:
+    """Masses far below the stable ones: the relaxation blows up. Exit 3 (not 2: the input was accepted), the
+    history up to the step whose forces were not finite, that record marked, no numpy warning on stderr."""
+    from ctmrpim.solvers import dynamic_relaxation
+    stable = dynamic_relaxation.relaxation_mass
+    monkeypatch.setattr(dynamic_relaxation, "relaxation_mass", lambda system: 1e-3 * stable(system))
+    out = tmp_path / "out"
+    code, _, stderr = _run(capsys, "run", *RELAXATION, "--set", "dynamic.steps=2000", "--out", str(out), "--quiet")
+    assert code == 3 and "Warning" not in stderr.replace("ctmrpim: warning:", "")
+    assert re.search(r"dynamic: dynamic relaxation diverged at step \d+ \(non-finite forces\)", stderr)
+    summary = _json(out / "summary.json")
+    assert summary["status"] == "not converged" and summary["history"][-1]["note"] == "diverged: non-finite forces"
+    assert summary["history"][-1]["residual"] is None     # infinite: null with a note
+    assert any(n.startswith(f"history[{len(summary['history']) - 1}].residual is undefined") for n in summary["notes"])
+
+
 def test_interrupted_in_process(tmp_path, capsys, monkeypatch) -> None:
     def interrupted(*args, **kw):
         raise KeyboardInterrupt
@@ -177,28 +218,44 @@ def test_interrupted_in_process(tmp_path, capsys, monkeypatch) -> None:
 def test_ctrl_c_exits_130_and_keeps_the_checkpoint(tmp_path) -> None:
     """SIGINT to the console script during an explicit run: exit 130, one line, no traceback, the status
     "interrupted", the checkpoint kept for --resume."""
-    out = tmp_path / "out"
-    proc = subprocess.Popen(_cli() + ["run", "column-collapse", "--set", "nodes.grid=[16,9]", "--set",
-                                      "explicit.duration=5", "--set", "explicit.checkpoint_every=20",
-                                      "--set", "explicit.rest=1e-12",   # no early rest: the run outlasts the signal
-                                      "--out", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            # a test run in the background of a non-interactive shell (CI, the fresh-checkout check)
-                            # inherits SIGINT ignored, and Python then keeps ignoring it: give the child the default
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    stderr = _stopped_by(signal.SIGINT, tmp_path / "out", 130)
+    assert stderr.splitlines()[-1] == "ctmrpim: interrupted"
+
+
+def test_sigterm_exits_143_and_keeps_the_checkpoint(tmp_path) -> None:
+    """SIGTERM (kill, a batch system's time limit) ends a run as Ctrl-C does, with exit status 143: the
+    status "interrupted" (not "running" for ever), the checkpoint kept, no half-written file."""
+    stderr = _stopped_by(signal.SIGTERM, tmp_path / "out", 143)
+    assert stderr.splitlines()[-1] == "ctmrpim: terminated (SIGTERM)"
+    assert _json(tmp_path / "out" / "status.json")["error"] == "terminated (SIGTERM)"
+
+
+def _default_signals() -> None:
+    # a test run in the background of a non-interactive shell (CI, the fresh-checkout check) inherits SIGINT
+    # ignored, and Python then keeps ignoring it: give the child the default dispositions
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, signal.SIG_DFL)
+
+
+def _stopped_by(sig: signal.Signals, out: Path, exit_status: int) -> str:
+    """Send ``sig`` to the console script once its explicit run has written a checkpoint into ``out``; check the
+    exit status, the status record, the checkpoint kept and that nothing is left half-written; its stderr."""
+    proc = subprocess.Popen(_cli() + ["run", *EXPLICIT, "--out", str(out)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, preexec_fn=_default_signals)
     deadline = time.time() + 120
     while time.time() < deadline and proc.poll() is None and not (out / "checkpoint.npz").is_file():
         time.sleep(0.05)
     assert proc.poll() is None, proc.communicate()
     assert _json(out / "status.json")["state"] == "running"     # the explicit solver keeps the record
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(sig)
     stdout, stderr = proc.communicate(timeout=60)
-    assert proc.returncode == 130
-    assert stderr.splitlines()[-1] == "ctmrpim: interrupted" and "Traceback" not in stderr
-    assert "\r" not in stderr                       # stderr is a pipe: plain lines, if any
+    assert proc.returncode == exit_status, stderr
+    assert "Traceback" not in stderr and "\r" not in stderr     # stderr is a pipe: plain lines, if any
     status = _json(out / "status.json")
-    assert status["state"] == "interrupted" and status["exit_status"] == 130
+    assert status["state"] == "interrupted" and status["exit_status"] == exit_status
     assert (out / "checkpoint.npz").is_file() and not (out / "summary.json").exists()
+    assert not [p for p in out.rglob("*.tmp")]                   # no write was left half done
+    return stderr
 
 
 def test_undefined_errors_are_null_with_a_note(tmp_path, capsys) -> None:

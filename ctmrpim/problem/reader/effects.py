@@ -4,11 +4,14 @@ setting is harmless and common (a density in a problem without gravity).
 The rule: nothing the user wrote is silently without effect. The checks here need the whole file
 (a key's effect depends on the analysis and the material model); those that need the nodes
 (conflicting constraints, a load on a constrained edge, too few supports) are made where the
-selectors are evaluated (:mod:`ctmrpim.discretisation.boundary_conditions`).
+selectors are evaluated (:mod:`ctmrpim.discretisation.boundary_conditions`). Those that need the method
+chosen on the command line (CTM-RPIM's ``[method]`` keys under ``--solver fem``) are
+:func:`check_solver_effects`, which the command line calls.
 """
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterable
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.reader.problem_table import ProblemTable
@@ -20,6 +23,9 @@ MOHR_COULOMB_KEYS = ("c", "phi", "psi", "tension")
 LOADING_ANALYSES = ("quasi-static", "strength-reduction")
 #: analyses in which the density only enters through gravity (no inertia)
 STATIC_ANALYSES = ("linear", "quasi-static")
+#: per method other than CTM-RPIM: how a message names its solve, and the only [method] keys it reads (the
+#: finite elements: the '==' tolerance of the `where` selectors); a method not named here reads them all
+METHOD_KEYS_READ = {"fem": ("the finite-element solve", ("match_tolerance",))}
 
 
 def check_effects(raw: dict, table: ProblemTable, model: str, density: float) -> None:
@@ -75,3 +81,34 @@ def check_method_effects(raw: dict, analysis: str, model: str, method: Method) -
     for key, (read, by) in readers.items():
         if key in given and not read:
             raise ProblemError(f"{key} is read only by {by}: it has no effect here, remove it", key=f"method.{key}")
+
+
+def given_keys(section: str, resolved: dict, defaults: Iterable[str]) -> list[str]:
+    """The keys of ``section`` the user wrote (in the file or with ``--set``): those of the resolved input
+    ``resolved`` without an entry ``"section.key = value"`` in the ``defaults`` that were applied."""
+    defaulted = {d.split(" = ", 1)[0] for d in defaults}
+    return [k for k in resolved.get(section, {}) if f"{section}.{k}" not in defaulted]
+
+
+def check_solver_effects(given: Iterable[str], typed: Iterable[str], solver: str) -> None:
+    """``[method]`` keys that the method ``solver`` does not read: refused where they were ``typed`` with
+    ``--set`` for this run (the user asked for them now), warned about in one line where the file ``given``
+    them (every benchmark carries CTM-RPIM's [method] table, and its finite-element solve must still run)."""
+    if solver not in METHOD_KEYS_READ:
+        return
+    what, read = METHOD_KEYS_READ[solver]
+    only = f"--solver {solver} reads only {', '.join(f'method.{k}' for k in read)} of [method]"
+    typed_unread = [k for k in dict.fromkeys(typed) if k not in read]
+    if typed_unread:
+        names = ", ".join(f"method.{k}" for k in typed_unread)
+        remove = f"--set {names}=..." if len(typed_unread) == 1 else "those --set"
+        raise ProblemError(f"{names} {_have(typed_unread)} no effect on {what} ({only}): remove {remove}",
+                           key="--set")
+    unread = [k for k in given if k not in read]
+    if unread:
+        warnings.warn(f"[method] {', '.join(unread)} {_have(unread)} no effect on {what} ({only})", UserWarning,
+                      stacklevel=2)
+
+
+def _have(keys: list[str]) -> str:
+    return "has" if len(keys) == 1 else "have"
