@@ -36,6 +36,7 @@ import scipy.sparse as sp
 from ctmrpim.discretisation.ctm import BoundaryQuadrature, boundary_points
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator, value_operator
 from ctmrpim.discretisation.rpim import ShapeFunctions
+from ctmrpim.discretisation.stress_recovery import recovery_operator
 from ctmrpim.errors import ProblemError
 
 if TYPE_CHECKING:
@@ -225,3 +226,23 @@ class RecoveredDirichletTerm:
         op = self.operator if points is None else self.operator[:, (4 * points[:, None] + np.arange(4)).ravel()]
         blocks = sp.bsr_matrix((A, np.arange(k), np.arange(k + 1)), shape=(4 * k, 4 * k))
         return (op @ (blocks @ G)).tocsr()
+
+
+def recovered_consistency(conf: Configuration, method: Method, thickness: float, fixed: np.ndarray,
+                          N_boundary: sp.csr_matrix | None = None
+                          ) -> tuple[sp.bsr_matrix, RecoveredDirichletTerm, sp.csr_matrix]:
+    """The consistent scheme of a solver whose stress state lives at the integration points (small-strain
+    Mohr-Coulomb, updated-Lagrangian) on ``conf``: G~ (the gradient operator of the corrected test gradients), the
+    Dirichlet term with the stress recovered at the boundary's Gauss points (``fixed``: the constrained dofs), and
+    the shape functions there (b, n). ``N_boundary``: those values where the caller keeps them (a configuration
+    moved without a rebuild keeps its shape functions, so they are the values computed before the move)."""
+    if N_boundary is None:
+        boundary, sf_b, test_dx, test_dy = corrected_test_gradients(conf, method, thickness)
+        N_boundary = sf_b.N
+    else:
+        boundary = boundary_quadrature(conf.x, conf.boundary.edges)
+        test_dx, test_dy = corrected_gradients(conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf,
+                                               boundary, N_boundary, method.correction)
+    R = recovery_operator(boundary.points, conf.points, conf.w, conf.lengths.d_c)
+    term = RecoveredDirichletTerm(len(conf.x), fixed, boundary, N_boundary, R, thickness)
+    return gradient_operator(test_dx, test_dy), term, N_boundary

@@ -15,10 +15,8 @@ import scipy.sparse as sp
 from ctmrpim.discretisation import assembly, consistent_integration
 from ctmrpim.discretisation.boundary_loads import reference_loads
 from ctmrpim.discretisation.configuration import BoundaryTags, Configuration, boundary_tags, reference_configuration
-from ctmrpim.discretisation.lagrangian_operators import gradient_operator
 from ctmrpim.discretisation.nodal_average import RADIUS, KernelAverage
 from ctmrpim.discretisation.state_transfer import NodalProjection
-from ctmrpim.discretisation.stress_recovery import recovery_operator
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.problem.case import Case
@@ -51,11 +49,8 @@ def _consistent(case: Case, conf: Configuration, tags: BoundaryTags
                 ) -> tuple[sp.bsr_matrix, consistent_integration.RecoveredDirichletTerm]:
     """``method.integration = "ctm-vci"``: G of the corrected test gradients, and the Dirichlet consistency term
     with the stress recovered at the boundary's Gauss points from the points' (the history lives there)."""
-    thickness = case.problem.thickness
-    boundary, sf_b, test_dx, test_dy = consistent_integration.corrected_test_gradients(conf, case.method, thickness)
-    R = recovery_operator(boundary.points, conf.points, conf.w, conf.lengths.d_c)
-    term = consistent_integration.RecoveredDirichletTerm(len(conf.x), tags.fixed, boundary, sf_b.N, R, thickness)
-    return gradient_operator(test_dx, test_dy), term
+    test, term, _ = consistent_integration.recovered_consistency(conf, case.method, case.problem.thickness, tags.fixed)
+    return test, term
 
 
 def solve_elastoplastic(case: Case, progress: Callable[[Any], None] = lambda level: None) -> Result:

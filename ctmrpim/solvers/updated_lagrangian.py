@@ -17,13 +17,10 @@ written without a rebuild. The stress update is objective (:mod:`ctmrpim.materia
 Winget rotation for the rate form of linear elasticity, the left Cauchy-Green tensor for neo-
 Hookean) and the tangent its exact derivative (complex steps), geometric part included.
 
-With ``method.integration = "ctm-vci"`` every configuration gets the corrected test gradients of its own
-points and tracked boundary (:mod:`ctmrpim.discretisation.consistent_integration`: the integration constraints
-hold on x_n, where F_int is integrated), so F_int = G~_n^T (w_n P_n) and K = G~_n^T diag(w_n A) G_n (Petrov-
-Galerkin), and the Dirichlet consistency term on constrained edges with the traction P_n n_n of the stress
-recovered at the boundary's Gauss points from the points' (the state lives at the points only; the same
-answer as the small-strain Mohr-Coulomb path gives: :class:`~ctmrpim.discretisation.consistent_integration.
-RecoveredDirichletTerm`). Where a rebuild is skipped the correction is redone on the carried configuration.
+With ``method.integration = "ctm-vci"`` each configuration gets the corrected test gradients of its points
+and boundary (the constraints must hold on x_n, where F_int is integrated): F_int = G~_n^T (w_n P_n), K = G~_n^T
+diag(w_n A) G_n, and the Dirichlet term with P_n n_n recovered at the boundary points from the points', where
+the state lives (:mod:`ctmrpim.discretisation.consistent_integration`, ``RecoveredDirichletTerm``).
 
 Where state lives (docs/design.md, 'State under re-tracking'): at the integration points. On a rebuild it
 is L2-projected onto the nodes over the old points and evaluated at the new points
@@ -51,10 +48,8 @@ from ctmrpim.discretisation import assembly, consistent_integration
 from ctmrpim.discretisation.alpha_shape import Boundary, alpha_shape, carried_boundary
 from ctmrpim.discretisation.boundary_loads import BoundaryLoads
 from ctmrpim.discretisation.configuration import BoundaryTags, boundary_tags, build, lay_points, reference_cloud
-from ctmrpim.discretisation.lagrangian_operators import gradient_operator
 from ctmrpim.discretisation.rpim import ShapeFunctions
 from ctmrpim.discretisation.state_transfer import project_to_nodes, transfer
-from ctmrpim.discretisation.stress_recovery import recovery_operator
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.linear_elastic import LinearElastic
 from ctmrpim.materials.neo_hookean import NeoHookean
@@ -221,26 +216,15 @@ class AdaptiveBody:
         self.timer.lap("shape_functions")
 
     def _set_gradient(self, carried: bool = False) -> None:
-        """G of the current configuration and the transpose of the test gradients' (G^T, or with ``ctm-vci`` that
-        of the corrected ones, with the Dirichlet term), kept across the Newton iterations. A ``carried``
-        configuration (moved without a rebuild) keeps its shape functions, so the values at the boundary's Gauss
-        points are those computed where the points were before the move."""
+        """G of the current configuration and the transpose of the test gradients' (G^T, or with ``ctm-vci`` the
+        corrected ones', and the Dirichlet term), kept across the Newton iterations; a ``carried`` configuration
+        (moved without a rebuild) keeps its shape functions, so their values at the boundary points too."""
         self.G = self.conf.block_gradient()
         self.GT = self.G.T
-        if self.case.method.integration != "ctm-vci":
-            return
-        conf = self.conf
-        boundary = consistent_integration.boundary_quadrature(conf.x, conf.boundary.edges)
-        if not carried:
-            self.N_boundary = conf.shape_functions_at(boundary.points, derivatives=False).N
-        test_dx, test_dy = consistent_integration.corrected_gradients(
-            conf.x, self.lengths.d_c, conf.points, conf.w / self.thickness, conf.sf, boundary, self.N_boundary,
-            self.case.method.correction)
-        self.GT = gradient_operator(test_dx, test_dy).T.tobsr()
-        R = recovery_operator(boundary.points, conf.points, conf.w, self.lengths.d_c)
-        term = consistent_integration.RecoveredDirichletTerm(len(self.x), self.fixed, boundary, self.N_boundary, R,
-                                                             self.thickness)
-        self.dirichlet = term if term.active else None
+        if self.case.method.integration == "ctm-vci":
+            test, term, self.N_boundary = consistent_integration.recovered_consistency(
+                self.conf, self.case.method, self.thickness, self.fixed, self.N_boundary if carried else None)
+            self.GT, self.dirichlet = test.T.tobsr(), (term if term.active else None)
 
     @property
     def boundary(self) -> Boundary:
