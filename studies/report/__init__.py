@@ -15,6 +15,7 @@ from pathlib import Path
 
 import studies
 from ctmrpim.io.atomic import atomic_write_text
+from studies import explicit_conservation
 from studies.integration_schemes import scheme_table
 from studies.report import dynamics, large_deformation, linear, stability, summary
 from studies.report.checks import all_checks, claims_table, console_summary
@@ -54,6 +55,11 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     stability.write_stability_fields(w, quick, out_dir, progress)
     stability.write_slope_slide(w, tables["slope_slide"])
     dynamics.write_column_collapse(w, tables["column_collapse"], quick)
+    progress("explicit_conservation: momentum of a free flight and a spin, ctm and ctm-vci")
+    flights, operators = explicit_conservation.measure(quick)
+    atomic_write_text(out_dir / "explicit_conservation.csv", flights.to_csv(index=False))
+    atomic_write_text(out_dir / "explicit_conservation_operators.csv", operators.to_csv(index=False))
+    dynamics.write_momentum_conservation(w, flights, operators, tables["column_collapse"])
     dynamics.write_collapse_settings(w, tables["column_collapse_settings"])
     dynamics.write_collapse_viscosity(w, tables["column_collapse_viscosity"])
     dynamics.write_full_mode_notes(w, out_dir)

@@ -79,8 +79,8 @@ def stability_checks(slopes: pd.DataFrame, footing: pd.DataFrame) -> pd.DataFram
 
 
 def collapse_checks(df: pd.DataFrame) -> pd.DataFrame:
-    """The column collapse against the experiment, for every run that reached the end of the flow
-    (at rest, or FINAL; quick mode: none)."""
+    """The column collapse against the experiment, and its energy ledger, for every run that reached the end of the
+    flow (at rest, or FINAL; quick mode: none)."""
     rows = []
     if "end_time_s" not in df:
         return pd.DataFrame(rows)
@@ -90,6 +90,9 @@ def collapse_checks(df: pd.DataFrame) -> pd.DataFrame:
         rows.append(_row("column-collapse-height", abs(r.height_at_wall_m / 0.100 - 1.0), variant))
         rows.append(_row("column-collapse-surface", r.surface_max_dev_m, variant))
         rows.append(_row("column-collapse-slope", r.slope_deg, variant))
+        # the energy ledger over the work of gravity: the bookkeeping identity and the material's accounts
+        rows.append(_row("column-collapse-energy-balance", abs(r.energy_balance), f"{variant}, central differences"))
+        rows.append(_row("column-collapse-energy-balance", abs(r.material_balance), f"{variant}, material"))
     return pd.DataFrame(rows)
 
 

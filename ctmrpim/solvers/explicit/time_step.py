@@ -8,6 +8,14 @@ step is dt = cfl x 2 / omega_max (cfl = 0.5 covers the estimate's shortfall, pla
 shortened by the stiffness-proportional damping where there is one (:func:`stable_step`).
 The textbook bound 0.4 d_min / c_p (c_p the P-wave speed) is reported beside it. The explicit run
 recomputes the step on its frame at every rebuild (:class:`TimeStepping`).
+
+Why the power iteration is sound: with the paper's CTM (the only scheme of explicit analyses) the operator
+K = G^T W C G is symmetric positive semi-definite (the same gradients G test and trial, C the elasticity
+tensor with its symmetries), so M^-1/2 K M^-1/2 has real, non-negative eigenvalues and the Rayleigh quotient
+rises to omega_max^2 (measured on the quick column: asymmetry 9e-17, omega_max 4680 rad/s from 30 iterations
+against 4697 from the eigenvalues). The corrected test gradients of ``ctm-vci`` would make it non-symmetric
+(asymmetry 1.5e-2, eigenvalues with imaginary parts up to 1.1e-4 of the largest): one of the reasons explicit
+analyses integrate with ``ctm`` (:mod:`ctmrpim.solvers.explicit.run`).
 """
 from __future__ import annotations
 
