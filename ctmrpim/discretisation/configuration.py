@@ -204,7 +204,7 @@ def reference_cloud(case: Case, timer: Timer) -> ReferenceCloud:
         raise ProblemError(f"the geometry has {expected} boundary loops, the node cloud resolves "
                            f"{len(boundary.loops)}: a hole about the node spacing ({lengths.d_c:.3g}) across or "
                            "smaller is lost; refine the nodes or remove the hole", key="nodes")
-    timer.lap("boundary")
+    timer.lap("boundary", nodes=len(nodes), loops=len(boundary.loops))
     return ReferenceCloud(nodes, lengths, boundary)
 
 
@@ -225,9 +225,9 @@ def reference_configuration(case: Case, timer: Timer) -> Configuration:
     else:
         quad, w = lay_points(loops, lengths, thickness)
         points = quad.points
-    timer.lap("integration")
+    timer.lap("integration", integration_points=len(w))
     conf = build(cloud.nodes, cloud.boundary, points, w, lengths, quadrature=quad)
-    timer.lap("shape_functions")
+    timer.lap("shape_functions", integration_points=len(w), nonzeros=int(conf.sf.N.nnz))
     return conf
 
 
@@ -239,7 +239,7 @@ def _nodal_configuration(cloud: ReferenceCloud, loops: list[np.ndarray], thickne
     tree = cKDTree(nodes)
     values = lambda pts: shape_functions(nodes, pts, derivatives=False, tree=tree, **lengths.rpim()).N
     nodal = smoothed_gradients(nodes, loops, cloud.boundary.edges, values)
-    timer.lap("integration")
+    timer.lap("integration", integration_points=len(nodes))
     sf = ShapeFunctions(sp.identity(len(nodes), format="csr"), nodal.bx, nodal.by, np.diff(nodal.bx.indptr))
     timer.lap("shape_functions")
     return Configuration(nodes, lengths, cloud.boundary, nodes.copy(), nodal.areas * thickness, sf, tree,

@@ -65,7 +65,7 @@ def solve_ctmrpim(case: Case) -> Result:
     conf = reference_configuration(case, timer)
     tags = boundary_tags(case, conf.x, conf.boundary, conf.lengths)
     N_traction = conf.shape_functions_at(tags.traction.points, derivatives=False).N
-    timer.lap("shape_functions")
+    timer.lap("shape_functions", boundary_points=len(tags.traction.points))
     sf, nodes, d_c, quad, boundary = conf.sf, conf.x, conf.lengths.d_c, conf.quadrature, conf.boundary
     fixed, fixed_values, traction_q = tags.fixed, tags.fixed_values, tags.traction
 
