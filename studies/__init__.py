@@ -19,7 +19,8 @@ if TYPE_CHECKING:
 NAMES = ["node_density", "integration_density", "support_radius", "shape_parameter", "parameter_map",
          "time_to_accuracy", "plate_hole_convergence", "integration_schemes", "tip_load", "end_moment", "slope_stability",
          "slope_srf_sweep", "slope_relaxation", "footing_bearing", "slope_slide", "column_collapse",
-         "column_collapse_settings", "column_collapse_viscosity"]
+         "column_collapse_settings", "column_collapse_viscosity",
+         "nonlinear_schemes"]   # last: it re-uses the nonlinear studies' cases (their cache) with the paper's scheme
 #: command-line spelling (dashes) -> module name
 ALIASES = {n.replace("_", "-"): n for n in NAMES}
 

@@ -28,8 +28,8 @@ def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Resu
     if scheme == "ctm-vci" and analysis == "explicit":
         # measured by studies/explicit_conservation.py (docs/design.md, 'Explicit dynamics')
         raise ProblemError("method.integration = \"ctm-vci\" does not conserve momentum in explicit dynamics (its "
-                           "corrected test gradients do not sum to zero: a spinning body's momenta drift by "
-                           "1e-4 in 1000 steps, with \"ctm\" by less than 1e-15); explicit analyses integrate with \"ctm\"",
+                           "corrected test gradients do not sum to zero, so a free body's linear and angular momentum "
+                           "drift; the report measures it); explicit analyses integrate with \"ctm\"",
                            key="method.integration")
     if scheme not in ("ctm", "ctm-vci") and analysis != "linear":   # the comparators: linear analyses only
         raise ProblemError(f"method.integration = {scheme!r} is implemented for linear analyses; this {analysis!r} "

@@ -6,7 +6,7 @@ statement, our value, the analytical reference, the finite-element value, pass/f
 
 ``make_report`` (here) runs the studies and writes the sections in order; ``checks`` holds the
 tolerance checks, ``markdown`` the table formatting, and ``summary``, ``linear``,
-``large_deformation``, ``stability`` and ``dynamics`` one function per section.
+``large_deformation``, ``stability``, ``dynamics`` and ``nonlinear_schemes`` one function per section.
 """
 from __future__ import annotations
 
@@ -20,6 +20,7 @@ from studies.integration_schemes import scheme_table
 from studies.report import dynamics, large_deformation, linear, stability, summary
 from studies.report.checks import all_checks, claims_table, console_summary
 from studies.report.markdown import Progress
+from studies.report.nonlinear_schemes import write_nonlinear_schemes
 from studies.sweep import Sweep
 from studies.time_to_accuracy import targets_table
 
@@ -62,6 +63,7 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     dynamics.write_momentum_conservation(w, flights, operators, tables["column_collapse"])
     dynamics.write_collapse_settings(w, tables["column_collapse_settings"])
     dynamics.write_collapse_viscosity(w, tables["column_collapse_viscosity"])
+    write_nonlinear_schemes(w, tables["nonlinear_schemes"])
     dynamics.write_full_mode_notes(w, out_dir)
     path = out_dir / "REPORT.md"
     atomic_write_text(path, buf.getvalue())

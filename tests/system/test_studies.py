@@ -2,6 +2,7 @@
 tolerances table; one study alone in the fast tier."""
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 import pytest
 from verify import check
@@ -77,3 +78,19 @@ def test_integration_schemes_table(tables) -> None:
     check("cantilever-jittered-vci-energy-rate", t.loc["ctm-vci (1/3, 1 pt)", "jittered_energy_rate"])
     # the paper's CTM and background cells are not consistent: their patch tests fail by 1e-3 or more
     assert (t.loc[["ctm (1/3, 1 pt)", "cell-gauss (d_c, 2x2)"], "patch_error"] > 1e-3).all()
+
+
+@pytest.mark.slow
+def test_nonlinear_schemes_table(tables) -> None:
+    """Every nonlinear benchmark with both schemes, the explicit one refusing ctm-vci; on the total-Lagrangian
+    path (exact stress at the boundary points) the consistent scheme is not farther from the reference."""
+    from studies.nonlinear_schemes import comparison
+
+    t = comparison(tables["nonlinear_schemes"]).set_index(["benchmark", "formulation"])
+    assert set(t.index.get_level_values(0)) == {"tip-load", "end-moment", "slope", "footing", "column-collapse"}
+    assert t.loc[("column-collapse", "explicit"), "refused"] and np.isnan(t.loc[("column-collapse", "explicit"),
+                                                                               "ctm-vci"])
+    ran = t[t.refused == ""]
+    assert ran[["ctm", "ctm-vci", "time_ratio"]].notna().all().all()
+    tl = ran.xs("TL", level="formulation")
+    assert (tl["ctm-vci"].abs() <= tl["ctm"].abs()).all()
