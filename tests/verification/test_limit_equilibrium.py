@@ -43,3 +43,35 @@ def test_top_surface_of_a_problem_geometry() -> None:
 
     g = Geometry(add=[Shape("polygon", [(0, 0), (32, 0), (12, 10), (0, 10)])])
     assert np.allclose(top_surface(g), GRIFFITHS_LANE)
+
+
+VERTICAL_CUT = np.array([[0, 20], [20, 20], [20, 10], [40, 10]], float)    # H = 10 m on 10 m of clay, base y = 0
+TAYLOR = 3.83 * 78.3e3 / (20e3 * 10.0)                                     # Taylor's N = gamma H / (F c) = 3.83
+
+
+def test_top_surface_keeps_a_vertical_face() -> None:
+    """The face of a cut is a vertical segment of the ground surface, crest end first, not a slope to the next
+    vertex."""
+    poly = shapely.Polygon([(0, 0), (40, 0), (40, 10), (20, 10), (20, 20), (0, 20)])
+    assert np.allclose(top_surface(poly), VERTICAL_CUT)
+
+
+def test_vertical_cut_against_taylor() -> None:
+    """The vertical-cut benchmark (undrained, H = 10 m, c = 78.3 kPa, 20 kN/m3): Taylor's 3.83 gives 1.50; the
+    critical circle enters behind the crest and exits through the face, its centre in front of the face."""
+    from ctmrpim import benchmarks
+    from ctmrpim.reference.limit_equilibrium import problem_factor_of_safety
+
+    s = problem_factor_of_safety(benchmarks.load("vertical-cut").problem)
+    check("bishop-vertical-cut", abs(s.fs / TAYLOR - 1.0))
+    assert 0.0 < s.x_entry < 20.0 - 5.0 and 19.9 <= s.x_exit <= 20.0 < s.xc
+
+
+def test_circles_must_enter_and_exit_through_the_ground() -> None:
+    """The circle the search took before (FS 1.077): tangent to the base, still 10 m below the ground at the
+    model's right edge; and a circle whose centre is below the crest, its lower arc ending under the ground."""
+    assert bishop(VERTICAL_CUT, 20e3, 78.3e3, 0.0, 41.524, 34.608, 34.608, base=0.0) is None
+    assert bishop(VERTICAL_CUT, 20e3, 78.3e3, 0.0, 12.0, 15.0, 6.0, base=0.0) is None
+    # one crossing of the face and one of the foundation beyond it: the mass behind the face counts alone
+    s = bishop(VERTICAL_CUT, 20e3, 78.3e3, 0.0, 36.0, 34.7, 29.4, base=0.0)
+    assert s is not None and s.x_exit <= 20.0 and s.fs == pytest.approx(TAYLOR, rel=0.01)
