@@ -63,8 +63,8 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     dynamics.write_momentum_conservation(w, flights, operators, tables["column_collapse"])
     dynamics.write_collapse_settings(w, tables["column_collapse_settings"])
     dynamics.write_collapse_viscosity(w, tables["column_collapse_viscosity"])
-    write_nonlinear_schemes(w, tables["nonlinear_schemes"])
     dynamics.write_full_mode_notes(w, out_dir)
+    write_nonlinear_schemes(w, tables["nonlinear_schemes"])
     path = out_dir / "REPORT.md"
     atomic_write_text(path, buf.getvalue())
     progress("\n" + console_summary(checks, claim_rows))
