@@ -1,7 +1,7 @@
 """Corners on a moving cloud: the updated-Lagrangian solver carries the reference triangulation (corners
 kept) while it stays valid, where the alpha shape of the moved nodes cuts a re-entrant corner with a
 triangle across the notch. An L-shape turned through 90 degrees by its prescribed edge (neo-Hookean,
-eight increments, a rebuild after each)."""
+eight increments, a rebuild after each), a stepped column's corner in the explicit solver and the sliding slope's toe."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -93,3 +93,20 @@ def test_the_explicit_solver_keeps_a_stepped_columns_corner(tmp_path) -> None:
     assert frame.boundary.area == pytest.approx(0.015, rel=1e-12) and run.tracking == [1, 0]
     alpha = alpha_shape(run.X, run.lengths.alpha, run.d_c)
     assert corner not in set(alpha.edges.ravel().tolist()) and alpha.area > 0.015
+
+
+@pytest.mark.slow
+def test_the_sliding_slope_keeps_its_toe(tmp_path) -> None:
+    """The slope sliding at SRF 1.6 (slope-slide on a coarse cloud, 4 s): the re-entrant toe (40, 5) stays a
+    vertex of the tracked boundary, where the alpha shape of the moved nodes cuts it."""
+    from ctmrpim import benchmarks
+    from ctmrpim.solvers.explicit.run import ExplicitRun
+
+    case = benchmarks.load("slope-slide", ["parameters.h=1.0", "explicit.duration=4.0", "explicit.save_every=4.0"])
+    run = ExplicitRun(case, tmp_path, "key")
+    run.start()
+    run.run(progress=False)
+    toe = int(np.argmin(np.hypot(run.X[:, 0] - 40.0, run.X[:, 1] - 5.0)))
+    assert np.hypot(*(run.x[toe] - run.X[toe])) > 0.1            # the toe has moved with the slide
+    assert toe in set(run.frame.boundary.edges.ravel().tolist()) and run.tracking[1] == 0
+    assert toe not in set(alpha_shape(run.x, run.lengths.alpha, run.d_c).edges.ravel().tolist())
