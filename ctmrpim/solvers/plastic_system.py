@@ -91,6 +91,7 @@ class PlasticSystem:
     tangent: str = "consistent"             # "consistent" (Newton) or "elastic" (see the module)
     tangents: int = 0                       # tangents built
     factorisations: int = 0                 # LU factorisations (a tangent equal to the last one reuses them)
+    safeguarded_steps: int = 0              # iterations whose singular consistent tangent gave way to the elastic one
     clock: Timer = field(default_factory=Timer)   # seconds per phase of the iterations
     test: sp.bsr_matrix | None = None       # ctm-vci: G of the corrected test gradients (Petrov-Galerkin)
     dirichlet: Any = None                   # ctm-vci: its Dirichlet consistency term (RecoveredDirichletTerm)
@@ -105,6 +106,7 @@ class PlasticSystem:
         self._K: sp.csr_matrix | None = None
         self._K_elastic: sp.csr_matrix | None = None
         self._lu = None
+        self._lu_elastic = None             # the elastic stiffness's factors, for the safeguarded steps
 
     def strain_increment(self, U: np.ndarray) -> np.ndarray:
         """(m, 3) exx, eyy, gxy at the points from the committed dofs to the interleaved dofs U (2n,)."""
@@ -191,24 +193,65 @@ class PlasticSystem:
 
     def solve(self, K: sp.csr_matrix, residual: np.ndarray) -> np.ndarray:
         """du (2n,) with K du = ``residual`` (2n,) at the free dofs and du = 0 at the fixed ones, reusing the LU
-        factors of K (2n x 2n) while K is unchanged."""
+        factors of K (2n x 2n) while K is unchanged.
+
+        The safeguard: a consistent tangent that SuperLU finds exactly singular, or whose step is not finite,
+        is replaced for this iteration by the elastic stiffness (:meth:`_safeguarded`); only a singular
+        elastic stiffness is bad input (constraints that leave a rigid-body motion free)."""
         with self.clock.measure("factorisation"):
             if self._lu is None or self._lu[0] is not K:
-                Kff = K[self.free][:, self.free].tocsc()
                 try:
-                    self._lu = (K, spla.splu(Kff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=PIVOT_THRESHOLD,
-                                             options={"SymmetricMode": True}))
+                    self._lu = (K, self._factorise(K))
                 except RuntimeError as exc:
-                    raise ProblemError(f"the tangent stiffness is singular ({exc})") from None
+                    if K is self._K_elastic:
+                        raise self._unconstrained(exc) from None
+                    return self._safeguarded(residual)
                 self.factorisations += 1
         with self.clock.measure("substitution"):
             du = np.zeros_like(residual)
             du[self.free] = self._lu[1].solve(residual[self.free])
+        if K is not self._K_elastic and not np.all(np.isfinite(du)):
+            return self._safeguarded(residual)
+        return du
+
+    def _factorise(self, K: sp.csr_matrix):
+        """SuperLU factors of K (2n x 2n) at the free dofs; RuntimeError where a pivot is exactly zero."""
+        return spla.splu(K[self.free][:, self.free].tocsc(), permc_spec="MMD_AT_PLUS_A",
+                         diag_pivot_thresh=PIVOT_THRESHOLD, options={"SymmetricMode": True})
+
+    @staticmethod
+    def _unconstrained(exc: Exception) -> ProblemError:
+        return ProblemError(f"the elastic stiffness is singular ({exc}): the constraints do not stop every "
+                            "rigid-body motion, or part of the body is detached", key="constraint")
+
+    def _safeguarded(self, residual: np.ndarray) -> np.ndarray:
+        """du (2n,) from the elastic stiffness, for an iteration whose consistent tangent is singular.
+
+        The consistent tangent of perfect plasticity loses rank where points return to the apex (D_ep = 0
+        there: every strain increment leaves sigma = c cot(phi)) or where a whole element's points sit on
+        one yield plane with its flow unresisted (a mechanism the element can follow freely); a finite
+        element whose quadrature points all do so leaves its dofs without stiffness. Those states occur in
+        Newton's trial iterates past a limit point long before the increment is judged, so the step of
+        that iteration is taken with the elastic stiffness (always regular once constrained, factorised
+        once), which points downhill in the residual without assuming the plastic flow: the iteration goes
+        on, and the increment converges, or is cut back as any other, by the load stepping's criteria.
+        Counted in ``safeguarded_steps``."""
+        self.safeguarded_steps += 1
+        K = self.elastic_stiffness()
+        if self._lu_elastic is None:
+            try:
+                self._lu_elastic = self._factorise(K)
+            except RuntimeError as exc:
+                raise self._unconstrained(exc) from None
+            self.factorisations += 1
+        du = np.zeros_like(residual)
+        du[self.free] = self._lu_elastic.solve(residual[self.free])
         return du
 
     def iteration_counts(self) -> dict[str, Any]:
         """Tangents built, factorisations and the seconds spent in each phase of the iterations."""
         return {"tangents": self.tangents, "factorisations": self.factorisations,
+                "safeguarded_steps": self.safeguarded_steps,
                 "iteration_seconds": {k: round(v, 3) for k, v in self.clock.phases.items()}}
 
     def run(self, loading: Loading, material_at: Callable[[float], MohrCoulomb],

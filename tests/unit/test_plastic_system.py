@@ -1,5 +1,5 @@
-"""Pieces of the method-agnostic plastic system: Anderson mixing, block rows of the gradient operator, and
-the finite-element gradient operator."""
+"""Pieces of the method-agnostic plastic system: Anderson mixing, block rows of the gradient operator, the
+finite-element gradient operator, and the safeguarded step where a consistent tangent is singular."""
 from __future__ import annotations
 
 import numpy as np
@@ -42,3 +42,17 @@ def test_fem_gradient_operator_is_exact_for_a_linear_field() -> None:
     U = np.where(np.arange(basis.N) % 2 == 0, 2 * x[0] + 3 * x[1], -x[0] + 5 * x[1])
     grad = (gradient_operator(basis) @ U).reshape(-1, 4)
     assert np.allclose(grad, [2, 3, -1, 5], atol=1e-12)
+
+
+def test_a_singular_tangent_gives_the_elastic_step() -> None:
+    """A tangent SuperLU finds exactly singular (all of it plastic at the apex: D_ep = 0) is replaced for that
+    iteration by the elastic stiffness, and counted; the tangent's own factors are used where it is regular."""
+    system = ctm_plastic_system(benchmarks.load("slope", ["parameters.h=2.5"]), Timer())[0]
+    K_elastic = system.elastic_stiffness()
+    r = np.random.default_rng(0).normal(size=K_elastic.shape[0])
+    r[system.fixed] = 0.0
+    du = system.solve(sp.csr_matrix(K_elastic.shape), r)
+    assert system.safeguarded_steps == 1
+    assert np.allclose((K_elastic @ du)[system.free], r[system.free]) and not du[system.fixed].any()
+    twice = (2.0 * K_elastic).tocsr()
+    assert np.allclose(system.solve(twice, r), 0.5 * du) and system.safeguarded_steps == 1
