@@ -183,6 +183,15 @@ def _cauchy(material: NeoHookean, basis: Basis, U: np.ndarray) -> np.ndarray:
     return np.stack([sig[:, 0, 0], sig[:, 1, 1], sig[:, 0, 1], material.lam * np.log(J) / J]).reshape(4, nel, nq)
 
 
+def _strain_energy(material: NeoHookean, basis: Basis, U: np.ndarray) -> float:
+    """int W(F) dX with W = mu/2 (tr C + 1 - 3) - mu ln J + lambda/2 (ln J)^2 (the module's neo-Hookean model
+    in plane strain), by the rule of ``basis``."""
+    F = _deformation_gradients(basis, U)
+    lnJ = np.log(np.linalg.det(F))
+    W = material.mu / 2 * ((F * F).sum((1, 2)) - 2) - material.mu * lnJ + material.lam / 2 * lnJ ** 2
+    return float(W @ np.asarray(basis.dx).ravel())
+
+
 def _split(stress: np.ndarray) -> dict[str, np.ndarray]:
     """``stress`` (n, 3) and ``stress_zz`` (n,) of nodal stresses (n, 4: sxx, syy, sxy, szz)."""
     return {"stress": stress[:, :3], "stress_zz": stress[:, 3]}
@@ -284,4 +293,4 @@ def solve_fem_hyperelastic(case: Case, element: str = "p2", refine: int = 0) -> 
         history=history, series=series,
         parameters={**case.resolved, "derived": {"d_c": fm.d_c, "element": element, "refine": refine,
                                                  "mu": material.mu, "lambda": material.lam}},
-        defaults=list(case.defaults))
+        defaults=list(case.defaults), outcome={"strain_energy": thickness * _strain_energy(material, basis, U)})

@@ -103,7 +103,8 @@ def solve_fem(case: Case, element: str = "q1") -> Result:
                 "integration_points": int(np.asarray(basis.dx).size)},
         timings=timer.total(),
         parameters={**case.resolved, "derived": {"d_c": fm.d_c, "element": element}},
-        defaults=list(case.defaults))
+        defaults=list(case.defaults),
+        outcome={"strain_energy": 0.5 * float(u @ (K @ u))})   # 1/2 u.K u (K carries the thickness)
 
 
 def _voigt(grad: np.ndarray) -> np.ndarray:

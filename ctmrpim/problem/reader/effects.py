@@ -25,7 +25,8 @@ LOADING_ANALYSES = ("quasi-static", "strength-reduction")
 STATIC_ANALYSES = ("linear", "quasi-static")
 #: per method other than CTM-RPIM: how a message names its solve, and the only [method] keys it reads (the
 #: finite elements: the '==' tolerance of the `where` selectors); a method not named here reads them all
-METHOD_KEYS_READ = {"fem": ("the finite-element solve", ("match_tolerance",))}
+METHOD_KEYS_READ = {"fem": ("the finite-element solve", ("match_tolerance",)),
+                    "fenicsx": ("the FEniCSx solve", ("match_tolerance",))}
 
 
 def check_effects(raw: dict, table: ProblemTable, model: str, density: float) -> None:
