@@ -287,8 +287,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--solver", choices=methods.names(), default=methods.DEFAULT,
                    help="the method (default ctm-rpim; fem: the scikit-fem reference; fenicsx: dolfinx 0.5 in the "
                         "system Python, on the same mesh)")
-    p.add_argument("--element", help="element of a finite-element method: q1, p1 or p2 for fem, also q2 for fenicsx "
-                                     "(default q1)")
+    p.add_argument("--element", help="element of a finite-element method: q1, p1 or p2 for fem, also q2 and p3 for "
+                                     "fenicsx (default q1)")
     p.add_argument("--quiet", action="store_true", help="print nothing on success (no progress either)")
     p.add_argument("--resume", action="store_true",
                    help="explicit dynamics: continue from the checkpoint in the output folder")

@@ -43,6 +43,8 @@ INSTALL = ("apt-get install python3-dolfinx (Debian 12: dolfinx 0.5 for /usr/bin
 #: environment variables the worker keeps (the JIT cache lives under HOME or XDG_CACHE_HOME); nothing else of the
 #: project's environment (VIRTUAL_ENV, PYTHONPATH ...) reaches it
 KEPT = ("HOME", "LANG", "LC_ALL", "TMPDIR", "XDG_CACHE_HOME", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS")
+#: seconds the version check may take (importing dolfinx takes about one)
+VERSION_TIMEOUT = 120.0
 #: the worker's exit status for each kind of failure (reference_fem/fenicsx_worker/__main__.py)
 MISSING, VERSION, PROBLEM, CONVERGENCE = 3, 4, 5, 6
 
@@ -64,13 +66,15 @@ def _refusal(why: str) -> ProblemError:
     return ProblemError(f"fenicsx needs FEniCSx (dolfinx 0.5): {why}; install it with {INSTALL}", key="--solver")
 
 
-def _run(args: list[str], cwd: str) -> subprocess.CompletedProcess:
+def _run(args: list[str], cwd: str, timeout: float | None = None) -> subprocess.CompletedProcess:
     python = interpreter()
     try:
         return subprocess.run([python, "-I", str(WORKER), *args], cwd=cwd, env=_environment(), capture_output=True,
-                              text=True, check=False)
+                              text=True, check=False, timeout=timeout)
     except OSError as exc:       # no such interpreter, or not executable
         raise _refusal(f"{python} cannot be run ({exc.strerror})") from None
+    except subprocess.TimeoutExpired:
+        raise _refusal(f"{python} did not answer within {timeout:g} s") from None
 
 
 @cache
@@ -78,7 +82,7 @@ def versions() -> dict[str, str]:
     """The versions the worker finds (dolfinx, ufl, petsc4py, python); a ProblemError saying what to install
     where dolfinx is missing or unsupported. Starts the interpreter once per process (about a second)."""
     with tempfile.TemporaryDirectory(prefix="ctmrpim-fenicsx-") as tmp:
-        done = _run(["--version"], tmp)
+        done = _run(["--version"], tmp, timeout=VERSION_TIMEOUT)
     if done.returncode != 0:
         raise _refusal(_last_line(done.stderr) or f"the worker exited with status {done.returncode}")
     return json.loads(done.stdout)
@@ -163,4 +167,4 @@ def solve_fenicsx(case: Case, element: str | None, options: RunOptions) -> Resul
 
 
 METHOD = SolutionMethod("fenicsx", solve_fenicsx, ELEMENTS,
-                        description="FEniCSx (dolfinx 0.5, system Python) on the same mesh as fem (Q1, P1, P2, Q2)")
+                        description="FEniCSx (dolfinx 0.5, system Python) on the same mesh as fem (Q1, P1, P2, Q2, P3)")

@@ -12,7 +12,7 @@ constraints, a rigid-body motion, a load that only acts on supports), made by it
 from __future__ import annotations
 
 import numpy as np
-from skfem import Basis, ElementQuad2, ElementVector
+from skfem import Basis, ElementQuad2, ElementTriP3, ElementVector
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.linear_elastic import LinearElastic
@@ -24,16 +24,26 @@ from reference_fem.boundary_conditions import FACET_ORDER, constrained_dofs, loc
 from reference_fem.mesh import FemMesh, build_mesh
 
 #: elements of the FEniCSx method, the first the default (as the scikit-fem reference's: q1 on a tensor grid)
-ELEMENTS = ("q1", "p1", "p2", "q2")
-DEGREE = {"p1": 1, "p2": 2, "q1": 1, "q2": 2}
-#: for q2, which the scikit-fem reference lacks: rules exact for the stiffness, the mass matrix and Q2 loads
-Q2_ORDERS = {"stiffness": 4, "tangent": 4, "projection": 4}
+ELEMENTS = ("q1", "p1", "p2", "q2", "p3")
+DEGREE = {"p1": 1, "p2": 2, "q1": 1, "q2": 2, "p3": 3}
+#: the element whose scikit-fem mesh an element without a scikit-fem counterpart uses
+MESH_OF = {"q2": "q1", "p3": "p1"}
+#: rules of the elements the scikit-fem reference lacks: exact for the stiffness and the mass matrix (twice the
+#: degree), the hyperelastic tangent one order above that
+EXTRA_ORDERS = {"q2": {"stiffness": 4, "tangent": 4, "projection": 4},
+                "p3": {"stiffness": 4, "tangent": 6, "projection": 6}}
 PROTOCOL = 1
 
 
 def fem_mesh(case: Case, element: str) -> FemMesh:
-    """The scikit-fem reference's mesh of ``case``'s nodes for ``element`` (q2: the q1 mesh of quads)."""
-    return build_mesh(case, "q1" if element == "q2" else element)
+    """The scikit-fem reference's mesh of ``case``'s nodes for ``element`` (q2: the q1 mesh of quads, p3: the p1
+    mesh of triangles)."""
+    try:
+        return build_mesh(case, MESH_OF.get(element, element))
+    except ProblemError as exc:
+        if element in MESH_OF:        # name the element asked for, not the one whose mesh it borrows
+            raise ProblemError(exc.reason.replace(MESH_OF[element], element, 1), key=exc.key) from None
+        raise
 
 
 def _degree(cell_type: str, order: int) -> int:
@@ -46,12 +56,13 @@ def _degree(cell_type: str, order: int) -> int:
 def quadrature(element: str, cell_type: str, analysis: str) -> dict[str, int]:
     """The quadrature degrees of each integral, the scikit-fem reference's (:mod:`reference_fem.solve`,
     :mod:`reference_fem.hyperelastic`)."""
+    extra = EXTRA_ORDERS.get(element)
     if analysis == "linear":
-        stiffness = Q2_ORDERS["stiffness"] if element == "q2" else solve.STIFFNESS_ORDER[element]
+        stiffness = extra["stiffness"] if extra else solve.STIFFNESS_ORDER[element]
         projection = solve.ERROR_ORDER
     else:
-        stiffness = Q2_ORDERS["tangent"] if element == "q2" else hyperelastic.TANGENT_ORDER[element]
-        projection = hyperelastic.PROJECTION_ORDER
+        stiffness = extra["tangent"] if extra else hyperelastic.TANGENT_ORDER[element]
+        projection = extra["projection"] if extra else hyperelastic.PROJECTION_ORDER
     return {"stiffness": _degree(cell_type, stiffness), "load": _degree(cell_type, stiffness),
             "projection": _degree(cell_type, projection), "error": _degree(cell_type, solve.ERROR_ORDER),
             "facet": FACET_ORDER}
@@ -124,7 +135,7 @@ def validate(case: Case, fm: FemMesh, element: str, tol: float) -> None:
     acting only on supports, selectors that pick no vertex or no segment."""
     problem = case.problem
     from reference_fem.solve import SCALAR_ELEMENTS
-    scalar = ElementQuad2() if element == "q2" else SCALAR_ELEMENTS[element]()
+    scalar = {"q2": ElementQuad2, "p3": ElementTriP3}.get(element, SCALAR_ELEMENTS.get(element))()
     constrained_dofs(problem, fm, Basis(fm.mesh, ElementVector(scalar), intorder=1), tol)
     loads = [(f"traction[{i}]", t.where) for i, t in enumerate(problem.tractions)] + \
         [(f"pressure[{i}]", p.where) for i, p in enumerate(problem.pressures)]

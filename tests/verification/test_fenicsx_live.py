@@ -119,3 +119,19 @@ def test_q2_on_the_cantilever(solutions) -> None:
     assert q2.errors["energy"] < p2.errors["energy"]
     root = q2.points[:, 0] == 0.0
     assert np.allclose(q2.u[root], case.problem.exact.displacement(*q2.points[root].T), rtol=0, atol=1e-15)
+
+
+@live
+def test_p3_reproduces_the_cantilevers_cubic_solution(solutions) -> None:
+    """The Timoshenko field is a cubic polynomial: P3 holds it exactly, so every load, prescribed value and
+    norm the worker translated from the problem's text is checked to round-off."""
+    result = solutions(golden.BY_NAME["cantilever-p2"].load(), method="fenicsx", element="p3")
+    assert result.method == "fenicsx-p3"
+    assert result.errors["l2"] < 1e-10 and result.errors["energy"] < 1e-10
+    assert result.errors["probes"]["tip"]["uy"] < 1e-10
+
+
+def test_q2_and_p3_name_themselves_when_refused(tmp_path: Path) -> None:
+    done = _run("cantilever", "--solver", "fenicsx", "--element", "q2", "--set", "nodes.spacing=2.0",
+                "--out", str(tmp_path / "out"), env=_env(str(tmp_path / "no-python")))
+    assert done.returncode == 2 and "q2 needs a rectangular body" in done.stderr
