@@ -18,8 +18,6 @@ from fx_expressions import Translator
 from fx_mesh import MeshData, facet_tags, select, vertex_values
 from petsc4py import PETSc
 
-FAMILY = {"p": "Lagrange", "q": "Lagrange"}
-
 
 class WorkerProblem(ValueError):
     """The problem cannot be solved as posed (the bridge turns it into a ProblemError: exit 2)."""
