@@ -21,10 +21,9 @@ from ctmrpim.result import Result
 from ctmrpim.run_options import RunOptions
 
 
-def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Result:
-    """Solve ``case`` with CTM-RPIM (``element`` is always None: the method has none)."""
-    analysis = case.problem.analysis
-    scheme = case.method.integration
+def check_integration(case: Case) -> None:
+    """Refuse (ProblemError, one line) a ``method.integration`` the case's analysis does not implement."""
+    analysis, scheme = case.problem.analysis, case.method.integration
     if scheme == "ctm-vci" and analysis == "explicit":
         # measured by studies/explicit_conservation.py (docs/design.md, 'Explicit dynamics')
         raise ProblemError("method.integration = \"ctm-vci\" does not conserve momentum in explicit dynamics (its "
@@ -34,6 +33,12 @@ def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Resu
     if scheme not in ("ctm", "ctm-vci") and analysis != "linear":   # the comparators: linear analyses only
         raise ProblemError(f"method.integration = {scheme!r} is implemented for linear analyses; this {analysis!r} "
                            "analysis integrates with \"ctm\" or \"ctm-vci\"", key="method.integration")
+
+
+def solve_meshfree(case: Case, element: str | None, options: RunOptions) -> Result:
+    """Solve ``case`` with CTM-RPIM (``element`` is always None: the method has none)."""
+    check_integration(case)
+    analysis = case.problem.analysis
     if analysis == "explicit":
         from ctmrpim.solvers.explicit.run import solve_explicit
         if options.out is None:

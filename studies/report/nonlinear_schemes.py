@@ -36,7 +36,7 @@ def write_nonlinear_schemes(w: Writer, df: pd.DataFrame) -> None:
           + f" closer with {CONSISTENT}; time x{ran.time_ratio[g.index].min():.2f} to "
           f"x{ran.time_ratio[g.index].max():.2f}). ")
     for _, r in t[t.refused != ""].iterrows():
-        w(f"{r.benchmark} ({r.formulation}) refuses {CONSISTENT}: \"{r.refused.split(': ', 1)[-1]}\". ")
+        w(f"{r.benchmark} ({r.formulation}) refuses {CONSISTENT}: \"{r.refused}\". ")
     nonlinear = sorted({a for a in ("quasi-static", "strength-reduction", "dynamic", "explicit")
                         if DEFAULT_INTEGRATION.get(a, PAPER) == PAPER})
     w(f"Default of the nonlinear analyses ({', '.join(nonlinear)}): {PAPER}; of linear analyses: "
