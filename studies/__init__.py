@@ -17,7 +17,8 @@ if TYPE_CHECKING:
     from studies.sweep import Sweep
 
 NAMES = ["node_density", "integration_density", "support_radius", "shape_parameter", "parameter_map",
-         "time_to_accuracy", "plate_hole_convergence", "integration_schemes", "tip_load", "end_moment", "slope_stability",
+         "time_to_accuracy", "plate_hole_convergence", "integration_schemes", "fe_references",
+         "tip_load", "end_moment", "slope_stability",
          "slope_srf_sweep", "slope_relaxation", "footing_bearing", "slope_slide", "column_collapse",
          "column_collapse_settings", "column_collapse_viscosity",
          "nonlinear_schemes"]   # last: it re-uses the nonlinear studies' cases (their cache) with the paper's scheme

@@ -6,7 +6,7 @@ statement, our value, the analytical reference, the finite-element value, pass/f
 
 ``make_report`` (here) runs the studies and writes the sections in order; ``checks`` holds the
 tolerance checks, ``markdown`` the table formatting, and ``summary``, ``linear``,
-``large_deformation``, ``stability``, ``dynamics`` and ``nonlinear_schemes`` one function per section.
+``large_deformation``, ``stability``, ``dynamics``, ``fe_references`` and ``nonlinear_schemes`` one function per section.
 """
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ from studies import explicit_conservation
 from studies.integration_schemes import scheme_table
 from studies.report import dynamics, large_deformation, linear, stability, summary
 from studies.report.checks import all_checks, claims_table, console_summary
+from studies.report.fe_references import write_fe_references
 from studies.report.markdown import Progress
 from studies.report.nonlinear_schemes import write_nonlinear_schemes
 from studies.sweep import Sweep
@@ -45,6 +46,7 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     linear.write_parameter_studies(w, tables)
     linear.write_plate_hole(w, tables["plate_hole_convergence"])
     linear.write_integration_schemes(w, tables["integration_schemes"], scheme_table(tables["integration_schemes"]))
+    write_fe_references(w, tables["fe_references"])
     large_deformation.write_tip_load(w, tables["tip_load"])
     large_deformation.write_end_moment(w, tables["end_moment"])
     large_deformation.write_deformed_shapes(w, quick, out_dir, progress)

@@ -94,3 +94,19 @@ def test_nonlinear_schemes_table(tables) -> None:
     assert ran[["ctm", "ctm-vci", "time_ratio"]].notna().all().all()
     tl = ran.xs("TL", level="formulation")
     assert (tl["ctm-vci"].abs() <= tl["ctm"].abs()).all()
+
+
+@pytest.mark.slow
+def test_fe_references_table(tables) -> None:
+    """Every golden case ran with both codes; scikit-fem matches the committed FEniCSx results on the same mesh."""
+    from reference_fem.fenicsx_golden import CASES
+    from studies.fe_references import converged_table, three_codes
+
+    t = three_codes(tables["fe_references"])
+    assert len(t) == len(CASES)
+    linear = t[~t.case.str.startswith("tip-load")]
+    check("fenicsx-linear-energy", linear.energy_skfem_vs_fenicsx.max())
+    check("fenicsx-tip-load-energy", t[t.case.str.startswith("tip-load")].energy_skfem_vs_fenicsx.max())
+    c = converged_table(tables["fe_references"])
+    assert c["ctm-rpim"].notna().all()
+    check("ctmrpim-converged-fenicsx", c["ctm-rpim_rel_diff"].abs().max())
