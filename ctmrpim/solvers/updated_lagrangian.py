@@ -15,7 +15,8 @@ P_n = det f sigma f^-T the first Piola-Kirchhoff stress relative to x_n, f = I +
 F_int = sum_p w_{n+1} sigma grad N_{n+1} on x_{n+1} (grad N_{n+1} = grad N_n f^-1, w_{n+1} = w_n det f)
 written without a rebuild. The stress update is objective (:mod:`ctmrpim.materials.objective_stress`: Hughes-
 Winget rotation for the rate form of linear elasticity, the left Cauchy-Green tensor for neo-
-Hookean) and the tangent its exact derivative (complex steps), geometric part included.
+Hookean) and the tangent its exact derivative (closed form for neo-Hookean, complex steps for the rate law),
+geometric part included.
 
 With ``method.integration = "ctm-vci"`` each configuration gets the corrected test gradients of its points
 and boundary (the constraints must hold on x_n, where F_int is integrated): F_int = G~_n^T (w_n P_n), K = G~_n^T
@@ -57,7 +58,6 @@ from ctmrpim.materials.objective_stress import (
     HypoelasticUpdate,
     LeftCauchyGreenUpdate,
     check_orientation,
-    complex_step_tangent,
     det2,
     largest_strain,
 )
@@ -258,7 +258,7 @@ class AdaptiveBody:
         f = self.relative_gradient(du)
         check_orientation(f)
         P = self.update.first_piola(f, self.state)
-        A = complex_step_tangent(self.update, f, self.state)
+        A = self.update.tangent(f, self.state)
         f_ext, K_load = self.loads.forces(self.x + du.reshape(-1, 2), factor)
         K = tangent(self.G, A, self.w, self.GT)
         f_int = internal_force(self.G, P, self.w, self.GT)

@@ -94,3 +94,16 @@ def test_complex_step_tangent_matches_finite_differences(update) -> None:
         fm[:, i, J] -= h
         fd = (update.first_piola(fp, state) - update.first_piola(fm, state)).reshape(8, 4) / (2 * h)
         assert np.abs(A[:, :, k] - fd).max() <= 1e-7 * np.abs(A).max()
+
+
+def test_neo_hookean_closed_form_tangent_is_the_complex_step_one() -> None:
+    """The updated neo-Hookean tangent in closed form against complex steps, from strained states b_n (up to
+    30 % strain) and increments of 10 %."""
+    update = LeftCauchyGreenUpdate(NeoHookean(E, 0.3))
+    rng = np.random.default_rng(5)
+    f = np.eye(2)[None] + 0.1 * rng.standard_normal((200, 2, 2))
+    F0 = np.eye(2)[None] + 0.1 * rng.standard_normal((200, 2, 2))
+    b = F0 @ F0.transpose(0, 2, 1)
+    state = np.c_[b[:, 0, 0], b[:, 1, 1], b[:, 0, 1]]
+    A, reference = update.tangent(f, state), complex_step_tangent(update, f, state)
+    assert np.abs(A - reference).max() <= 1e-12 * np.abs(reference).max()
