@@ -1,17 +1,16 @@
 """Granular column collapse (paper Section 3.4, Figs. 26-28) against the experiment of Bui et al. (2008).
 
-The column (0.2 m x 0.1 m, aluminium rods: E = 0.84 MPa, nu = 0.3, c = 0, phi = 19.8 deg, psi = 0,
-rho = 2650 kg/m^3) is brought to rest under gravity behind its gate, the gate is removed and the
-explicit adaptive CTM-RPIM solver runs until the deposit is at rest (at most 1 s; with the benchmark's
-viscosity beta = 5e-6 s, about 0.6 s; see ``column_collapse_viscosity`` for the run without it, the
-paper's model as written, whose surface keeps sliding). Measured against the data in
-``ctmrpim/benchmarks/data/bui2008-column-collapse/``: run-out (where the surface falls below 0.01 m;
-0.36 m measured), height at the wall (0.100 m), the final free surface (largest and mean vertical
-distance at the measured abscissae), the failure line (the top of the region that moved less than
+The column of aluminium rods (benchmark ``column-collapse``: its size and material are quoted below, read from
+the benchmark) is brought to rest under gravity behind its gate, the gate is removed and the explicit adaptive
+CTM-RPIM solver runs until the deposit is at rest (with the benchmark's viscosity beta; see
+``column_collapse_viscosity`` for the run without it, the paper's model as written, whose surface keeps
+sliding). Measured against the data in ``ctmrpim/benchmarks/data/bui2008-column-collapse/``: run-out (where the
+surface falls below 0.01 m), height at the wall, the final free surface (largest and mean vertical distance
+at the measured abscissae), the failure line (the top of the region that moved less than
 ``STATIC``; mean distance of the measured points from it) and the surface's inclination between x = 0.04
-and 0.40 m (14.6 deg measured, below phi = 19.8 deg). The deposit is also measured at
-``FRONT_STOPPED`` = 0.4 s, when the front has stopped. Full mode: three node counts (496, 1071 = the
-paper's, 2016); quick mode (CI): the coarsest cloud for 0.1 s only (the machinery, not the deposit).
+and 0.40 m, each measured on the experiment's surface the same way. The deposit is also measured at
+``FRONT_STOPPED`` = 0.4 s, when the front has stopped. Full mode: three node counts, the middle one the
+paper's; quick mode (CI): the coarsest cloud for 0.1 s only (the machinery, not the deposit).
 """
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 
 The paper's model as written (rate-independent Mohr-Coulomb, no damping: ``explicit.viscosity = 0``)
 and four viscosities beta (s; a viscous stress beta D d(eps)/dt, :mod:`ctmrpim.solvers.explicit`) on the
-coarse cloud (31 x 16 = 496 nodes), each run until at rest (at most 1.5 s). Without viscosity the
+coarse cloud (31 x 16 nodes), each run until at rest (at most 1.5 s). Without viscosity the
 surface layer of the upper slope keeps sliding after the front has stopped and the surface flattens
 well below the measured one; the benchmark's beta = 5e-6 s was chosen from this sweep (it is fitted
 to the experiment, not derived). Measured against the experiment as in ``column_collapse``: run-out,

@@ -1,6 +1,7 @@
 """Markdown helpers of the report: tables as Markdown, error columns as percentages."""
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Iterable
 
 import numpy as np
@@ -27,3 +28,20 @@ def pct(df: pd.DataFrame, cols: Iterable[str]) -> pd.DataFrame:
 def md(df: pd.DataFrame) -> str:
     """``df`` as a Markdown table, without the index."""
     return df.to_markdown(index=False)
+
+
+def each(values: Iterable[float], spec: str, sep: str = " / ") -> str:
+    """``values`` formatted with ``spec`` and joined by ``sep`` (one per run: ``0.353 / 0.357 / 0.356``)."""
+    return sep.join(format(v, spec) for v in values)
+
+
+def span(values: Iterable[float], spec: str) -> str:
+    """The range of ``values`` formatted with ``spec``: ``lo-hi``, or one value where both ends print alike."""
+    v = list(values)
+    lo, hi = format(min(v), spec), format(max(v), spec)
+    return lo if lo == hi else f"{lo} to {hi}" if lo.startswith("-") or hi.startswith("-") else f"{lo}-{hi}"
+
+
+def sci(value: float, spec: str = "g") -> str:
+    """``value`` formatted with ``spec``, its exponent without padding (``5e-6``, not ``5e-06``)."""
+    return re.sub(r"e([+-])0*(\d)", r"e\1\2", format(value, spec))
