@@ -1,11 +1,9 @@
 """Strip footing bearing capacity (paper Section 3.3.2, Figs. 22-24): the pressure on the flexible
-footing is raised in increments (halved near the limit) until the undrained soil (c_u = 100 kPa,
-phi = psi = 0.001 deg) cannot carry it; the limit pressure is the bracket [last carried, first not
-carried], against Prandtl's (2 + pi) c_u = 514.2 kPa. CTM-RPIM and scikit-fem P2 on the same node
-grids (the default 49 x 21 = 1029 nodes is the paper's count), with the load-settlement curve of the
-footing centre. Smith & Griffiths report 5.1 cm at 500 kPa and collapse between 515 and 519 kPa with a
-coarse mesh; the paper about 6 cm at 500 kPa and failure at 520 kPa. The full run adds a coarser
-and a finer grid.
+footing is raised in increments (halved near the limit) until the undrained soil (phi = psi ~ 0)
+cannot carry it; the limit pressure is the bracket [last carried, first not carried], against Prandtl's
+(2 + pi) c_u. CTM-RPIM and scikit-fem P2 on the same node grids (the default 49 x 21 has the paper's node
+count), with the load-settlement curve of the footing centre, beside the published values of Smith &
+Griffiths and of the paper (the table below). The full run adds a coarser and a finer grid.
 """
 from __future__ import annotations
 

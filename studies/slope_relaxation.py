@@ -1,10 +1,10 @@
 """Slope by dynamic relaxation, the paper's own solver (Section 2.1.4, Eq. 11; Fig. 19): benchmark
 `slope` at each SRF on its own, gravity applied at once on the reduced strength and relaxed by
 explicit central differences with local damping f = 0.8 (fictitious Gershgorin mass, so one step is
-one pseudo-time unit) for up to 3000 steps (the paper: 2800), CTM-RPIM and scikit-fem P2 through the
-same driver. A level is stable when the out-of-balance force falls below 1e-4 of the weight; a failed
-level is still moving after 3000 steps and its displacement grows without bound. Quick mode: the
-coarser 668-node cloud and three SRF values.
+one pseudo-time unit) for a fixed budget of steps (``dynamic.steps``, as in the paper), CTM-RPIM and
+scikit-fem P2 through the same driver. A level is stable when the out-of-balance force falls below 1e-4 of
+the weight; a failed level is still moving at the end of its budget and its displacement grows without
+bound. Quick mode: the coarser cloud (h = 1.0 m) and three SRF values.
 """
 from __future__ import annotations
 

@@ -4,10 +4,10 @@ the two candidate geometries of Fig. 18 - `slope` (Smith & Griffiths 6.4 embankm
 scikit-fem P2 on the same nodes with the same PlasticSystem, return mapping and search (bracket by
 0.1 from SRF = 1 continuing from the last stable state, then bisection to 0.01; failure = non-convergence
 of the equilibrium iteration, see ctmrpim.solvers.strength_reduction), against Bishop's simplified method computed by us
-for each geometry (critical circle searched). The paper reports 1.3-1.4; Griffiths & Lane's
-finite elements 1.4. Node spacing h: the default clouds (0.58 m for `slope`, 1928 nodes, the paper's
-about 1881; 0.35 m for `slope-gl`, 1926 nodes) in the full run, beside coarser ones (1.0 m and 0.6 m,
-about 680 nodes) that show the trend with resolution; quick mode runs the coarser ones only.
+for each geometry (critical circle searched), and the published values (the side-by-side table above).
+Node spacing h: the default clouds (0.58 m for `slope`, close to the paper's node count; 0.35 m for
+`slope-gl`) in the full run, beside coarser ones (1.0 m and 0.6 m) that show the trend with resolution;
+quick mode runs the coarser ones only.
 """
 from __future__ import annotations
 
