@@ -1,6 +1,6 @@
 """Cantilever rolled up by a follower end moment (paper Figs. 16-17, Eq. 37): tip position against
 the exact circular arc x = L sin(t)/t, y = L (1 - cos t)/t, t = 2 pi m, for fractions m of the ring
-moment 2 pi E I / L; 81 x 5 = 405 nodes, neo-Hookean CTM-RPIM: adaptive updated-Lagrangian (UL, 64
+moment 2 pi E I / L; 81 x 5 nodes, neo-Hookean CTM-RPIM: adaptive updated-Lagrangian (UL, 64
 increments per ring, boundary re-tracked, CTM points laid anew and RPIM rebuilt after each, as in the
 paper), the same with the integration points carried by the body (UL carried: boundary and RPIM
 rebuilt, points and their state kept), total-Lagrangian (TL, 32 increments per ring), and scikit-fem

@@ -1,4 +1,4 @@
-"""Shape parameter (paper Fig. 12): eta from 1.5 to 10.5 step 1.0, 17 x 5 nodes, r = d_c/3,
+"""Shape parameter (paper Fig. 12): eta from 1.5 in steps of 1.0 over the paper's range, 17 x 5 nodes, r = d_c/3,
 r_c = 4 d_c. The paper claims eta in [3.5, 9.5] is accurate and [4.5, 7.5] low and stable.
 """
 from __future__ import annotations

@@ -1,6 +1,7 @@
 """Tip-loaded cantilever with large deflection (paper Fig. 14): tip deflection ratio w/L and
-horizontal shortening u/L against lambda = P L^2/(E I) for the paper's loads P = 100 .. 3000 kN,
-neo-Hookean CTM-RPIM (306 nodes, mid-height tip), adaptive updated-Lagrangian (UL: boundary
+horizontal shortening u/L against lambda = P L^2/(E I) for the paper's loads
+(``ctmrpim.reference.elastica.PAPER_LOADS_KN``; quick mode two of them), neo-Hookean CTM-RPIM (the benchmark's
+cloud, mid-height tip), adaptive updated-Lagrangian (UL: boundary
 re-tracked and CTM / RPIM rebuilt after every increment) and total-Lagrangian (TL, the cross-check),
 against the exact elastica, for
 two ways of applying P: a parabolic shear on the end face (benchmark tip-load, against the clean

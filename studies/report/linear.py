@@ -65,7 +65,11 @@ def write_time_to_accuracy(w: Writer, tta: pd.DataFrame) -> None:
 def write_parameter_studies(w: Writer, tables: dict[str, pd.DataFrame]) -> None:
     """One section per parameter study of the cantilever (Figs. 10-12 and the parameter map)."""
     for name, what in PARAMETER_STUDIES:
-        w(f"## {what}\n\n{studies.study(name).__doc__.strip()}\n\n")
+        module = studies.study(name)
+        w(f"## {what}\n\n{module.__doc__.strip()}\n\n")
+        parameter = getattr(module, "PARAMETER", None)
+        if parameter in tables[name]:
+            w(f"Values run: {parameter} = {', '.join(f'{v:g}' for v in sorted(tables[name][parameter].unique()))}.\n\n")
         w(md(pct(tables[name], ERRORS)))
         w(f"\n\n![{name}]({name}.png)\n\n")
 

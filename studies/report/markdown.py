@@ -31,7 +31,7 @@ def md(df: pd.DataFrame) -> str:
 
 
 def each(values: Iterable[float], spec: str, sep: str = " / ") -> str:
-    """``values`` formatted with ``spec`` and joined by ``sep`` (one per run: ``0.353 / 0.357 / 0.356``)."""
+    """``values`` formatted with ``spec`` and joined by ``sep`` (one per run: ``0.35 / 0.36``)."""
     return sep.join(format(v, spec) for v in values)
 
 
@@ -39,7 +39,7 @@ def span(values: Iterable[float], spec: str) -> str:
     """The range of ``values`` formatted with ``spec``: ``lo-hi``, or one value where both ends print alike."""
     v = list(values)
     lo, hi = format(min(v), spec), format(max(v), spec)
-    return lo if lo == hi else f"{lo} to {hi}" if lo.startswith("-") or hi.startswith("-") else f"{lo}-{hi}"
+    return lo if lo == hi else f"{lo} to {hi}" if lo[0] in "+-" or hi[0] in "+-" else f"{lo}-{hi}"
 
 
 def sci(value: float, spec: str = "g") -> str:
