@@ -1,0 +1,74 @@
+"""Frictional footings (issue 19): the Mohr-Coulomb solve does not break on valid input where the consistent
+tangent is singular (the scikit-fem P2 reference stopped with exit 2, "the tangent stiffness is singular"), a
+solve that gives up is reported as not converged (exit 3), and the limit pressure of the weightless c-phi
+footings against Prandtl-Reissner's c N_c by both methods."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from verify import check
+
+from ctmrpim import benchmarks
+from ctmrpim.cli import main
+from ctmrpim.methods import solve
+
+
+def prandtl_reissner(c: float, phi: float) -> float:
+    """q_u = c N_c of a weightless soil, N_c = (N_q - 1) cot(phi), N_q = exp(pi tan(phi)) tan^2(45 + phi / 2)."""
+    t = math.tan(math.radians(phi))
+    n_q = math.exp(math.pi * t) * math.tan(math.radians(45.0 + phi / 2.0)) ** 2
+    return c * (n_q - 1.0) / t
+
+
+#: the coarse cloud of the fast tier: h = B / 8 (495 nodes)
+COARSE = ["parameters.h=0.5"]
+
+
+def test_prandtl_reissner_factors() -> None:
+    """The factors the benchmark files quote: N_c = 14.835 (20 deg) and 30.14 (30 deg)."""
+    assert prandtl_reissner(1.0, 20.0) == pytest.approx(14.835, abs=5e-4)
+    assert prandtl_reissner(1.0, 30.0) == pytest.approx(30.14, abs=5e-3)
+
+
+def test_safeguarded_solve_of_a_frictional_footing() -> None:
+    """FE P2 on the coarse phi = 20 deg footing: apex returns make the consistent tangent exactly singular in
+    some iterations (before: exit 2); those steps take the elastic stiffness and the run finds the limit."""
+    case = benchmarks.load("footing-phi20", COARSE)
+    r = solve(case, "fem", "p2")
+    assert r.counts["safeguarded_steps"] > 0
+    limit = r.outcome["limit_pressure"]
+    assert limit["failed"] is not None and limit["carried"] < limit["failed"]
+    q_u = prandtl_reissner(1e4, 20.0)
+    check("footing-phi20-coarse-fem-p2-limit", max(abs(limit["carried"] / q_u - 1), abs(limit["failed"] / q_u - 1)))
+    carried = [h for h in r.history if h["converged"]]
+    w = -np.array([h["centre"]["uy"] for h in carried])
+    assert np.all(np.diff(w) > 0)
+
+
+def test_a_solve_that_gives_up_exits_3(tmp_path, capsys) -> None:
+    """The same footing loaded to twice its limit without ``until_failure``: not converged (exit 3) with the
+    converged increments in summary.json, not bad input (exit 2)."""
+    out = tmp_path / "out"
+    code = main(["run", "footing-phi20", "--solver", "fem", "--element", "p2", "--quiet", "--out", str(out),
+                 "--set", COARSE[0], "--set", "loading.until_failure=false", "--set", "loading.max_cutbacks=3"])
+    stderr = capsys.readouterr().err
+    assert code == 3 and stderr.startswith("ctmrpim: not converged: ") and "singular" not in stderr
+    history = json.loads((out / "summary.json").read_text())["history"]
+    assert history[-1]["converged"] is False
+    assert max(h["load_factor"] for h in history if h["converged"]) == pytest.approx(0.5, abs=0.05)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("phi", [20, 30])
+@pytest.mark.parametrize("solver, element, tag", [("ctm-rpim", None, "ctmrpim"), ("fem", "p2", "fem-p2")])
+def test_frictional_footing_limit_against_prandtl_reissner(phi: int, solver: str, element: str | None,
+                                                           tag: str) -> None:
+    """The benchmarks' own clouds (h = B / 16; 1885 and 3977 nodes): minutes each."""
+    r = solve(benchmarks.load(f"footing-phi{phi}"), solver, element)
+    limit = r.outcome["limit_pressure"]
+    assert limit["failed"] is not None and limit["carried"] < limit["failed"]
+    q_u = prandtl_reissner(1e4, phi)
+    check(f"footing-phi{phi}-{tag}-limit", max(abs(limit["carried"] / q_u - 1), abs(limit["failed"] / q_u - 1)))
