@@ -18,7 +18,9 @@ scikit-fem reference use the same one, with the same material class and the same
   plus a correction summed over the plastic points' rows of G only (footing: 84 s -> 54 s for the whole
   run; a tangent still costs about 0.1 s and its factorisation 0.08 s at 1029 nodes, a residual
   0.01 s). Reusing a stale plastic tangent (modified Newton) is unsafe: it is nearly singular in directions where the
-  current state is elastic, and the compressed Tresca block then diverges in its first increment;
+  current state is elastic, and the compressed Tresca block then diverges in its first increment.
+  Where the consistent tangent is exactly singular (apex returns), that iteration's step is the elastic
+  stiffness's (:meth:`PlasticSystem._safeguarded`);
 - ``"elastic"``: the elastic stiffness, assembled and factorised once for the whole analysis (it does
   not change with the strength reduction), each step Anderson-mixed with the last ones
   (:class:`ctmrpim.solvers.load_stepping.Anderson`). Measured on the 1928-node slope under gravity (16
@@ -232,10 +234,11 @@ class PlasticSystem:
         one yield plane with its flow unresisted (a mechanism the element can follow freely); a finite
         element whose quadrature points all do so leaves its dofs without stiffness. Those states occur in
         Newton's trial iterates past a limit point long before the increment is judged, so the step of
-        that iteration is taken with the elastic stiffness (always regular once constrained, factorised
-        once), which points downhill in the residual without assuming the plastic flow: the iteration goes
-        on, and the increment converges, or is cut back as any other, by the load stepping's criteria.
-        Counted in ``safeguarded_steps``."""
+        that iteration is taken with the elastic stiffness (regular once constrained, factorised once): the
+        step the elastic-stiffness iteration (``tangent = "elastic"``) takes, slower to converge but never
+        singular. The next iteration tries the consistent tangent again, and the
+        increment converges, or is cut back as any other, by the load stepping's criteria. Counted in
+        ``safeguarded_steps``."""
         self.safeguarded_steps += 1
         K = self.elastic_stiffness()
         if self._lu_elastic is None:

@@ -72,3 +72,14 @@ def test_frictional_footing_limit_against_prandtl_reissner(phi: int, solver: str
     assert limit["failed"] is not None and limit["carried"] < limit["failed"]
     q_u = prandtl_reissner(1e4, phi)
     check(f"footing-phi{phi}-{tag}-limit", max(abs(limit["carried"] / q_u - 1), abs(limit["failed"] / q_u - 1)))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("phi, larger", [(20, ["parameters.W=24", "parameters.D=10.5"]),
+                                         (30, ["parameters.W=36", "parameters.D=15"])])
+def test_the_domain_holds_the_mechanism(phi: int, larger: list[str]) -> None:
+    """Enlarging the benchmark's domain by half (FE P2 on the coarse cloud) leaves the limit where it was: the
+    boundaries are clear of the mechanism."""
+    limits = [solve(benchmarks.load(f"footing-phi{phi}", COARSE + extra), "fem", "p2").outcome["limit_pressure"]
+              for extra in ([], larger)]
+    check("footing-frictional-domain-change", max(abs(limits[1][k] / limits[0][k] - 1) for k in ("carried", "failed")))
