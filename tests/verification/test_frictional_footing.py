@@ -61,7 +61,7 @@ def test_a_solve_that_gives_up_exits_3(tmp_path, capsys) -> None:
     assert max(h["load_factor"] for h in history if h["converged"]) == pytest.approx(0.5, abs=0.05)
 
 
-@pytest.mark.slow
+@pytest.mark.long
 @pytest.mark.parametrize("phi", [20, 30])
 @pytest.mark.parametrize("solver, element, tag", [("ctm-rpim", None, "ctmrpim"), ("fem", "p2", "fem-p2")])
 def test_frictional_footing_limit_against_prandtl_reissner(phi: int, solver: str, element: str | None,
@@ -74,7 +74,7 @@ def test_frictional_footing_limit_against_prandtl_reissner(phi: int, solver: str
     check(f"footing-phi{phi}-{tag}-limit", max(abs(limit["carried"] / q_u - 1), abs(limit["failed"] / q_u - 1)))
 
 
-@pytest.mark.slow
+@pytest.mark.long
 @pytest.mark.parametrize("phi, larger", [(20, ["parameters.W=24", "parameters.D=10.5"]),
                                          (30, ["parameters.W=36", "parameters.D=15"])])
 def test_the_domain_holds_the_mechanism(phi: int, larger: list[str]) -> None:

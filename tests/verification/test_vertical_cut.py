@@ -11,7 +11,7 @@ from ctmrpim.methods import solve
 TAYLOR = 3.83 * 78.3e3 / (20e3 * 10.0)
 
 
-@pytest.mark.slow
+@pytest.mark.long
 @pytest.mark.parametrize("solver, element, tag", [("ctm-rpim", None, "ctmrpim"), ("fem", "p2", "fem-p2")])
 def test_vertical_cut_factor_of_safety_against_taylor(solver: str, element: str | None, tag: str) -> None:
     """The benchmark's own cloud (h = 0.35 m, 5075 nodes): about two minutes each."""
