@@ -54,17 +54,14 @@ def specs(quick: bool) -> list[CaseSpec]:
 def extra(summary: dict) -> dict:
     """The tip probe's displacements (the probe named tip, else the first) and the strain energy where the method
     reports it."""
-    probes = summary.get("probes", {})
-    tip = probes.get("tip") or next(iter(probes.values()), {})
+    tip = _tip(summary.get("probes", {}))
     return {"tip_ux": tip.get("ux", np.nan), "tip_uy": tip.get("uy", np.nan),
             "strain_energy": summary.get("strain_energy", np.nan)}
 
 
-def _golden_tip_uy(golden: dict) -> float:
-    """uy of the golden result's tip probe (the probe named tip, else the first; NaN without probes)."""
-    probes = golden["probes"]
-    tip = probes.get("tip") or next(iter(probes.values()), {})
-    return tip.get("uy", np.nan)
+def _tip(probes: dict) -> dict:
+    """The probe named tip, else the first; {} without probes (a summary's and a golden file's alike)."""
+    return probes.get("tip") or next(iter(probes.values()), {})
 
 
 def three_codes(df: pd.DataFrame) -> pd.DataFrame:
@@ -79,7 +76,7 @@ def three_codes(df: pd.DataFrame) -> pd.DataFrame:
         if fem.empty or ours.empty:
             continue
         fem, ours = fem.iloc[0], ours.iloc[0]
-        tip = _golden_tip_uy(golden)
+        tip = _tip(golden["probes"]).get("uy", np.nan)
         errors = golden.get("errors", {})
         rows.append({"case": g.name, "element": g.element, "nodes": int(ours.nodes),
                      "ctm-rpim_l2": ours.l2_error, "ctm-rpim_energy": ours.energy_error, "ctm-rpim_tip_uy": ours.tip_uy,
