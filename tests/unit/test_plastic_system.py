@@ -56,3 +56,19 @@ def test_a_singular_tangent_gives_the_elastic_step() -> None:
     assert np.allclose((K_elastic @ du)[system.free], r[system.free]) and not du[system.fixed].any()
     twice = (2.0 * K_elastic).tocsr()
     assert np.allclose(system.solve(twice, r), 0.5 * du) and system.safeguarded_steps == 1
+
+
+def test_a_tangent_with_a_zero_column_never_reaches_superlu() -> None:
+    """One free dof without stiffness (its column zero, its row not: a non-associated apex return) is refused
+    before SuperLU, whose pivoting crashes now and then on such a column (scipy 1.11), and the step is the
+    elastic one."""
+    system = ctm_plastic_system(benchmarks.load("slope", ["parameters.h=2.5"]), Timer())[0]
+    K_elastic = system.elastic_stiffness()
+    dof = system.free[len(system.free) // 2]
+    keep = sp.diags((np.arange(K_elastic.shape[0]) != dof).astype(float))
+    K = (K_elastic @ keep).tocsr()
+    r = np.random.default_rng(1).normal(size=K.shape[0])
+    r[system.fixed] = 0.0
+    du = system.solve(K, r)
+    assert system.safeguarded_steps == 1
+    assert np.allclose((K_elastic @ du)[system.free], r[system.free])
