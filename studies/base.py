@@ -82,6 +82,9 @@ def run_study(module: ModuleType, quick: bool = True, out_dir: Path = Path("repo
     atomic_write_text(out_dir / f"{module.NAME}.csv", df.to_csv(index=False))
     fig = module.figure(df)
     save_figure(fig, out_dir / f"{module.NAME}.png")
+    if not quick:   # a full-mode result records the code that made it (studies/provenance.py)
+        from studies.provenance import stamp
+        stamp(out_dir, module.NAME)
     return df
 
 

@@ -34,13 +34,14 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     checks through ``progress``; the report's path."""
     out_dir = Path(out_dir)
     tables = {name: studies.run(name, quick, out_dir, sweep, progress) for name in studies.NAMES}
-    checks = all_checks(tables)
+    checks = all_checks(tables, out_dir)
     claim_rows = claims_table(tables)
     buf = io.StringIO()
     w = buf.write
     summary.write_title(w, quick, checks, claim_rows)
-    summary.write_claims(w, claim_rows)
+    summary.write_claims(w, claim_rows, tables)
     summary.write_accuracy_checks(w, checks)
+    summary.write_provenance(w, out_dir)
     linear.write_node_density(w, tables["node_density"])
     linear.write_time_to_accuracy(w, targets_table(tables["time_to_accuracy"]))
     linear.write_parameter_studies(w, tables)

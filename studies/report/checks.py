@@ -1,12 +1,14 @@
-"""The report's checks: every verified number and every claim of the paper against the tolerances
-table (``studies/tolerances.toml``), one row per check with the reference, our value, the limit and
-pass/fail."""
+"""The report's checks: every verified number against the tolerances table (``studies/tolerances.toml``) as a
+regression pin, one row per check with the reference, our value, the limit and pass/fail; and the paper's claims
+as findings (:mod:`studies.claims`): holds, partly, does not hold, with our number and the paper's."""
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from studies import claims, tolerances
+from studies import claims, provenance, tolerances
 from studies.column_collapse import FINAL
 from studies.fitting import fitted_rate
 
@@ -97,29 +99,84 @@ def collapse_checks(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def claims_table(tables: dict[str, pd.DataFrame]) -> pd.DataFrame:
-    """One row per claim of the paper: the statement, what we measure, our value and whether it holds."""
+    """The paper's claims as findings: one row per measure of each claim (:data:`studies.claims.CLAIMS`), with
+    the claim's outcome (holds, partly, does not hold), what we measure, our value, the paper's statement and its
+    claim as a limit, and whether our value meets it."""
     values = claims.evaluate(tables)
     rows = []
-    for key, (_, statement, judged_by) in claims.CLAIMS.items():
-        r = _row(key, values[key])
-        holds = tolerances.passes(judged_by, values[key])
-        rows.append({"paper says": statement, "we measure": r["quantity"], "ours": r["ours"],
-                     "paper's claim holds": "yes" if holds else "**no**", "limit": r["limit"],
-                     "pass": r["pass"], "limit source": r["limit source"]})
+    for c in claims.CLAIMS:
+        found = claims.outcome(c, values)
+        for i, m in enumerate(x for x in c.measures if x.key in values):
+            r = _row(m.judged_by, values[m.key])
+            rows.append({"claim": f"{c.where}: {c.statement}" if i == 0 else "", "finding": found if i == 0 else "",
+                         "we measure": tolerances.entry(m.described_by)["quantity"], "ours": r["ours"],
+                         "the paper": tolerances.entry(m.judged_by)["reference"], "the paper's claim as a limit":
+                         r["limit"], "ours meets it": "yes" if r["pass"] == "pass" else "**no**",
+                         "outcome": found, "measure": m.key})
     return pd.DataFrame(rows)
 
 
-def all_checks(tables: dict[str, pd.DataFrame]) -> pd.DataFrame:
-    """Every tolerance check of the studies' ``tables``: linear and large-deformation accuracy, stability,
-    column collapse."""
-    return pd.concat([verification_checks(tables["node_density"], tables["plate_hole_convergence"],
-                                          tables["tip_load"], tables["end_moment"]),
-                      stability_checks(tables["slope_stability"], tables["footing_bearing"]),
-                      collapse_checks(tables["column_collapse"])], ignore_index=True)
+def claim_pins(tables: dict[str, pd.DataFrame]) -> pd.DataFrame:
+    """The regression pins of the claims' measures: each measured value against its pin (the paper's limit where
+    the claim holds, the recorded band of our value where it does not)."""
+    values = claims.evaluate(tables)
+    return pd.DataFrame([_row(m.pinned_by, values[m.key]) for c in claims.CLAIMS for m in c.measures
+                         if m.key in values])
+
+
+def full_mode_tables(out_dir: Path) -> dict[str, pd.DataFrame]:
+    """The committed full-mode tables under ``out_dir/full`` (their rows that ran), by study name."""
+    full = Path(out_dir) / "full"
+    out = {}
+    for f in sorted(full.glob("*.csv")):
+        df = pd.read_csv(f)
+        out[f.stem] = df[df.status == "ok"].reset_index(drop=True) if "status" in df else df
+    return out
+
+
+def full_collapse_checks(out_dir: Path) -> pd.DataFrame:
+    """The column collapse's checks on the committed full-mode table (``out_dir/full``), each row's case naming
+    the full mode and, where the table's provenance is not current, its state (:mod:`studies.provenance`)."""
+    df = full_mode_tables(out_dir).get("column_collapse")
+    if df is None:
+        return pd.DataFrame()
+    c = collapse_checks(df)
+    if c.empty:
+        return c
+    state = provenance.status(Path(out_dir) / "full", "column_collapse").state
+    flag = "" if state == "current" else f", {state}"
+    c["check"] = c.check.str.replace(r" \((\d+) nodes", rf" (full mode{flag}, \1 nodes", regex=True)
+    return c
+
+
+def all_checks(tables: dict[str, pd.DataFrame], out_dir: Path | None = None) -> pd.DataFrame:
+    """Every regression pin: linear and large-deformation accuracy, stability, column collapse (this run's, and
+    the committed full-mode table's under ``out_dir/full``), and the claims' measures."""
+    parts = [verification_checks(tables["node_density"], tables["plate_hole_convergence"], tables["tip_load"],
+                                 tables["end_moment"]),
+             stability_checks(tables["slope_stability"], tables["footing_bearing"]),
+             collapse_checks(tables["column_collapse"])]
+    if out_dir is not None:
+        parts.append(full_collapse_checks(out_dir))
+    parts.append(claim_pins(tables))
+    return pd.concat([p for p in parts if len(p)], ignore_index=True)
+
+
+def evaluated_keys(checks: pd.DataFrame, claim_rows: pd.DataFrame) -> set[str]:
+    """The tolerance keys the report evaluates (its pins' and the claims' limits)."""
+    keys = set(checks.check.str.split(" (", regex=False).str[0])
+    return keys | {claims.MEASURES[m].judged_by for m in claim_rows.measure}
+
+
+def limits_in_table() -> set[str]:
+    """The keys of the tolerances table that carry a limit (the published reference values carry none)."""
+    return {k for k, e in tolerances.table().items() if "min" in e or "max" in e}
 
 
 def console_summary(checks: pd.DataFrame, claim_rows: pd.DataFrame) -> str:
-    """Checks and claims in one plain-text table (check, ours, limit, pass), for the console."""
-    return pd.concat([checks[["check", "ours", "limit", "pass"]],
-                      claim_rows.rename(columns={"paper says": "check"})[["check", "ours", "limit", "pass"]]]
-                     ).to_string(index=False)
+    """Pins and claims in plain text (check, ours, limit, pass; claim, finding, ours, the paper's limit), for the
+    console."""
+    shown = claim_rows.assign(claim=claim_rows.measure)[["claim", "outcome", "ours", "the paper's claim as a limit",
+                                                         "ours meets it"]]
+    return (checks[["check", "ours", "limit", "pass"]].to_string(index=False) + "\n\nThe paper's claims:\n"
+            + shown.to_string(index=False))

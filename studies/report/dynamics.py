@@ -12,7 +12,7 @@ import pandas as pd
 
 import studies
 from ctmrpim import benchmarks
-from studies import column_collapse, tolerances
+from studies import column_collapse, provenance, tolerances
 from studies.column_collapse import FINAL, FRONT_STOPPED
 from studies.column_collapse_settings import EARLY, early_differences
 from studies.report.checks import collapse_checks
@@ -30,6 +30,8 @@ FULL_COLLAPSE_COLUMNS = ["grid", "nodes", "end_time_s", "steps", "rebuilds", "dt
 FULL_VISCOSITY_COLUMNS = ["viscosity_s", "nodes", "end_time_s", "steps", "run_out_m", "height_at_wall_m",
                           "surface_max_dev_m", "surface_mean_dev_m", "failure_line_mean_dist_m", "slope_deg",
                           "viscous_share", "plastic_share", "time_s"]
+#: the studies whose full-mode tables this section reads
+FULL_STUDIES = ("column_collapse", "column_collapse_viscosity", "column_collapse_settings")
 FULL_SETTINGS_COLUMNS = ["variant", "nodes", "early_time_s", "early_front_m", "surface_vs_fixed_step_max_m",
                          "surface_vs_fixed_step_mean_m", "steps", "rebuilds", "dt_min_s", "ms_per_step", "time_s"]
 
@@ -290,18 +292,24 @@ def write_full_mode_notes(w: Writer, out_dir: Path) -> None:
     """What the full runs measured, read from the committed full-mode tables under ``out_dir/full``, with their
     figures."""
     w("### Full mode (measured)\n\n")
-    cc, vs, st = (read_full(out_dir, n) for n in ("column_collapse", "column_collapse_viscosity",
-                                                   "column_collapse_settings"))
+    cc, vs, st = (read_full(out_dir, n) for n in FULL_STUDIES)
     w("Read from the full-mode tables committed under `reports/full/` (`ctmrpim study column-collapse --out "
       "reports/full`, the same for `column-collapse-viscosity` and `column-collapse-settings`).\n\n")
     if cc is None and vs is None and st is None:
         w("No full-mode table is present: nothing to quote.\n\n")
+    states = {n: provenance.status(Path(out_dir) / "full", n) for n in FULL_STUDIES
+              if (Path(out_dir) / "full" / f"{n}.csv").is_file()}
+    old = [n for n, s in states.items() if not s.usable]
+    if old:
+        w(f"**Not current** ({', '.join(f'{n}: {states[n].state}' for n in old)}): these tables were not made by "
+          "the numerics of this code (see 'Provenance of the committed full-mode results'); the numbers below are "
+          "what the code that made them measured.\n\n")
     if cc is not None:
         _collapse_notes(w, cc, vs)
     if vs is not None:
         _viscosity_notes(w, vs)
     if st is not None:
         _settings_notes(w, st)
-    for name in ("column_collapse", "column_collapse_viscosity", "column_collapse_settings"):
+    for name in FULL_STUDIES:
         if (out_dir / "full" / f"{name}.png").exists():
             w(f"![{name.replace('_', ' ')}, full mode](full/{name}.png)\n\n")

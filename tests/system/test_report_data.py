@@ -77,12 +77,13 @@ def render(reports: Path = REPORTS) -> tuple[str, set[str]]:
 
     everything = tuple(studies.NAMES)
     if set(everything) <= set(tables):
-        checks, claim_rows = all_checks(tables), claims_table(tables)
+        checks, claim_rows = all_checks(tables, reports), claims_table(tables)
         summary.write_title(w, True, checks, claim_rows)
-        summary.write_claims(w, claim_rows)
+        summary.write_claims(w, claim_rows, tables)
         summary.write_accuracy_checks(w, checks)
     else:
-        missing |= {"", "The paper's claims in our numbers", "Accuracy checks against analytical solutions"}
+        missing |= {"", summary.CLAIMS_HEADING, summary.PINS_HEADING}
+    summary.write_provenance(w, reports)
     t = tables.get
     section("Node density: cantilever, CTM-RPIM against scikit-fem (cf. Fig. 9)", ("node_density",),
             lambda: linear.write_node_density(w, t("node_density")))

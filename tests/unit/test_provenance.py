@@ -1,0 +1,83 @@
+"""Provenance of full-mode results (issue 22, item 7): a sidecar records the code that made a study's table and
+figure; a changed numerics source makes it stale, a rewritten file modified; the committed ones are stamped."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from studies import provenance
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _tree(root: Path) -> None:
+    """A miniature repository: the numerics packages, a study that imports a helper, and non-numerics modules."""
+    for rel, text in {"ctmrpim/solver.py": "x = 1\n", "ctmrpim/cli.py": "help = 'a'\n",
+                      "ctmrpim/benchmarks/beam.toml": "L = 1\n", "reference_fem/fem.py": "y = 2\n",
+                      "studies/demo.py": "from studies.helper import z\nfrom studies.sweep import CaseSpec\n",
+                      "studies/helper.py": "z = 3\n", "studies/sweep.py": "CaseSpec = None\n",
+                      "studies/other.py": "w = 4\n"}.items():
+        (root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (root / rel).write_text(text)
+
+
+@pytest.fixture
+def made(tmp_path: Path) -> tuple[Path, Path]:
+    root, out = tmp_path / "repo", tmp_path / "full"
+    _tree(root)
+    out.mkdir()
+    (out / "demo.csv").write_text("a,b\n1,2\n")
+    (out / "demo.png").write_bytes(b"\x89PNG fake")
+    provenance.stamp(out, "demo", root=root)
+    return root, out
+
+
+def test_the_numerics_sources_of_a_study(tmp_path: Path) -> None:
+    _tree(tmp_path)
+    files = provenance.numerics_files("demo", tmp_path)
+    assert "ctmrpim/solver.py" in files and "ctmrpim/benchmarks/beam.toml" in files
+    assert "reference_fem/fem.py" in files and {"studies/demo.py", "studies/helper.py"} <= set(files)
+    # the command line, the sweep executor and other studies compute nothing this study's numbers depend on
+    assert not {"ctmrpim/cli.py", "studies/sweep.py", "studies/other.py"} & set(files)
+
+
+def test_a_fresh_stamp_is_current(made) -> None:
+    root, out = made
+    record = json.loads(provenance.sidecar(out, "demo").read_text())
+    assert set(record["files"]) == {"demo.csv", "demo.png"} and record["mode"] == "full"
+    assert record["git_commit"] is None   # the miniature tree is no git repository
+    assert provenance.status(out, "demo", root).state == "current"
+
+
+def test_a_changed_source_makes_it_stale(made) -> None:
+    root, out = made
+    (root / "studies/sweep.py").write_text("CaseSpec = 1\n")   # not a numerics source
+    (root / "ctmrpim/cli.py").write_text("help = 'b'\n")
+    assert provenance.status(out, "demo", root).state == "current"
+    (root / "studies/helper.py").write_text("z = 4\n")
+    (root / "ctmrpim/new.py").write_text("")
+    s = provenance.status(out, "demo", root)
+    assert s.state == "stale" and s.changed == ["ctmrpim/new.py", "studies/helper.py"]
+    assert "studies/helper.py" in s.describe() and "2 numerics sources changed" in s.describe()
+    assert "2 numerics" not in s.describe(count=False)
+
+
+def test_a_rewritten_result_is_modified_and_a_missing_record_unstamped(made) -> None:
+    root, out = made
+    (out / "demo.csv").write_text("a,b\n1,3\n")
+    assert provenance.status(out, "demo", root).state == "modified"
+    provenance.sidecar(out, "demo").unlink()
+    assert provenance.status(out, "demo", root).state == "unstamped"
+
+
+def test_every_committed_full_mode_result_is_stamped() -> None:
+    """Each table and figure under reports/full/ has a sidecar that describes it as it is (its state against the
+    current code, current or stale, is the report's to state)."""
+    full = ROOT / "reports" / "full"
+    if not full.is_dir():
+        pytest.skip("no committed full-mode results")
+    for name in provenance.studies_in(full):
+        s = provenance.status(full, name)
+        assert s.state in ("current", "stale"), f"{name}: {s.state} ({s.describe()})"
