@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import sys
+from functools import cache
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -106,6 +107,50 @@ def converged_table(df: pd.DataFrame) -> pd.DataFrame:
                          "ctm-rpim_nodes": int(ours.nodes.iloc[0]) if len(ours) else 0,
                          "ctm-rpim_rel_diff": value / r["value"] - 1.0})
     return pd.DataFrame(rows)
+
+
+@cache
+def fenicsx_linear() -> pd.DataFrame:
+    """The committed FEniCSx results of the linear golden cases: the benchmark (``target``), the scikit-fem method
+    of the same element (``fem-ELEMENT``), the node count, the plane state, and FEniCSx's errors against the exact
+    solution: the tip probe's u_y (by the studies' rule, :func:`ctmrpim.result.probe_errors`), L2 and energy."""
+    from ctmrpim.result import probe_errors
+
+    rows = []
+    for g in CASES:
+        if not g.linear:
+            continue
+        golden, problem = read(g), g.load().problem
+        errors = golden.get("errors", {})
+        tip = probe_errors(problem, golden["probes"]).get("tip", {}).get("uy", np.nan)
+        rows.append({"target": g.target, "method": f"fem-{g.element}", "nodes": len(golden["mesh"]["points"]),
+                     "plane": problem.plane, "fenicsx_tip_error": tip, "fenicsx_l2_error": errors.get("l2", np.nan),
+                     "fenicsx_energy_error": errors.get("energy", np.nan)})
+    return pd.DataFrame(rows)
+
+
+#: the FEniCSx columns :func:`with_fenicsx` adds
+FENICSX_ERRORS = ("fenicsx_tip_error", "fenicsx_l2_error", "fenicsx_energy_error")
+
+
+def with_fenicsx(table: pd.DataFrame, target: str, columns: tuple[str, ...] = FENICSX_ERRORS) -> pd.DataFrame:
+    """``table`` (a study's rows of benchmark ``target``) with FEniCSx's errors beside each scikit-fem row that has
+    a committed FEniCSx result on the same mesh and element (same method and node count, and plane state where the
+    table has one); empty elsewhere."""
+    fx = fenicsx_linear()
+    fx = fx[fx.target == target]
+    keys = ["method", "nodes"] + (["plane"] if "plane" in table else [])
+    fx = fx[keys + list(columns)].drop_duplicates(keys)
+    return table.merge(fx, on=keys, how="left") if len(fx) else table.assign(**{c: np.nan for c in columns})
+
+
+def converged_tip_load() -> dict:
+    """The converged FEniCSx tip of the neo-Hookean tip load (the highest element order of
+    ``converged.json``): element, finest mesh, ux and uy (m) with their Richardson error estimates."""
+    s = max(json.loads(CONVERGED.read_text())["series"]["tip-load"], key=lambda s: s["element"])
+    return {"element": s["element"], "finest_mesh": s["meshes"][-1],
+            **{c: s[c]["richardson"]["value"] for c in ("ux", "uy")},
+            **{f"{c}_error": s[c]["richardson"]["error"] for c in ("ux", "uy")}}
 
 
 def figure(df: pd.DataFrame) -> Figure:

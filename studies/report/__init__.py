@@ -48,7 +48,7 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     linear.write_plate_hole(w, tables["plate_hole_convergence"])
     linear.write_integration_schemes(w, tables["integration_schemes"], scheme_table(tables["integration_schemes"]))
     write_fe_references(w, tables["fe_references"])
-    large_deformation.write_tip_load(w, tables["tip_load"])
+    large_deformation.write_tip_load(w, tables["tip_load"], tables["fe_references"])
     large_deformation.write_end_moment(w, tables["end_moment"])
     large_deformation.write_deformed_shapes(w, quick, out_dir, progress)
     stability.write_side_by_side(w, tables["slope_stability"], tables["footing_bearing"])

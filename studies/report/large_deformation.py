@@ -2,17 +2,24 @@
 ring, and their deformed configurations."""
 from __future__ import annotations
 
+import re
+import tomllib
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 import studies
+from ctmrpim import benchmarks
+from ctmrpim.reference.elastica import tip_load_elliptic
 from studies import deformed_shapes, tolerances
-from studies.report.markdown import Progress, Writer, md, span
+from studies.fe_references import converged_table, converged_tip_load
+from studies.report.markdown import Progress, Writer, md, sci, span
 
 
-def write_tip_load(w: Writer, tip: pd.DataFrame) -> None:
-    """The tip-loaded cantilever against the elastica (Figs. 13-14)."""
+def write_tip_load(w: Writer, tip: pd.DataFrame, fe: pd.DataFrame | None = None) -> None:
+    """The tip-loaded cantilever against the elastica (Figs. 13-14), and the converged FEniCSx value of the
+    continuum beam (with CTM-RPIM's distance from it from the three-codes study's rows ``fe``)."""
     w("## Large deflection: tip-loaded cantilever (cf. Figs. 13-14)\n\n")
     w(f"{studies.study('tip_load').__doc__.strip()}\n\n")
     tl = tip.drop(columns=["status", "d_c", "tip_error", "l2_error", "energy_error"],
@@ -46,8 +53,33 @@ def write_tip_load(w: Writer, tip: pd.DataFrame) -> None:
         exact = corner.set_index(key).w_over_L_exact / ours.set_index(key).w_over_L_exact - 1
         w(f"With the paper's corner load the tip deflects {span(100 * ratio.dropna(), '.1f')} % more, and the "
           f"elastica with the matching end moment predicts {span(100 * exact.dropna(), '.1f')} %. ")
+    _converged(w, fe)
     w("The paper's seven loads (full mode), the UL run with carried points and the beam turned against the CTM "
       "lines are not committed as tables (`reports/full/tip_load.csv`), so they are not quoted.\n\n")
+
+
+def _converged(w: Writer, fe: pd.DataFrame | None) -> None:
+    """The converged FEniCSx tip of the benchmark's own load against the elastica, and CTM-RPIM against it."""
+    c = converged_tip_load()
+    p = tomllib.loads(benchmarks.path("tip-load").read_text())["parameters"]
+    lam, length = float(p["lam"]), float(p["L"])
+    exact = tip_load_elliptic(lam)
+    w_l, u_l = -c["uy"] / length, -c["ux"] / length
+    w(f"The converged FEniCSx value of the continuum beam at the benchmark's own load, lambda = {lam:g} "
+      f"({c['element'].upper()} on meshes up to {' x '.join(re.findall(r'[0-9]+', c['finest_mesh']))} nodes, "
+      "Richardson; "
+      f"`reference_fem/golden/converged.json`): w/L = {w_l:.6f} and u/L = {u_l:.6f} (estimated errors "
+      f"{sci(c['uy_error'] / length, '.0e')} and {sci(c['ux_error'] / length, '.0e')} of L), "
+      f"{w_l / exact.w_over_L - 1:+.2%} and {u_l / exact.u_over_L - 1:+.2%} from the elastica's {exact.w_over_L:.6f} "
+      f"and {exact.u_over_L:.6f}: what the continuum beam differs from the elastica by, which no refinement "
+      "removes. ")
+    if fe is not None:
+        t = converged_table(fe)
+        t = t[(t.case == "tip-load") & (t.element == c["element"])]
+        if len(t) and not np.isnan(t["ctm-rpim"].iloc[0]):
+            r = t.iloc[0]
+            w(f"CTM-RPIM on the benchmark's {int(r['ctm-rpim_nodes'])} nodes (default settings, the three-codes "
+              f"study) lies {r['ctm-rpim_rel_diff']:+.3%} from it in u_y. ")
 
 
 def write_end_moment(w: Writer, moment: pd.DataFrame) -> None:
