@@ -122,7 +122,7 @@ def extra(summary: dict, folder: Path) -> dict:
 def _draw(ax, mesh: meshio.Mesh, vmax: float, title: str):
     x = mesh.points[:, :2]
     sc = ax.scatter(x[:, 0], x[:, 1], c=mesh.point_data["displacement"], s=3, cmap="viridis", vmin=0, vmax=vmax)
-    ax.set(aspect="equal", xlim=(-0.005, 0.46), ylim=(-0.005, 0.105), title=title)
+    ax.set(aspect="equal", xlim=(-0.005, 0.46), ylim=(-0.005, 0.105), title=title, xlabel="x (m)", ylabel="y (m)")
     ax.tick_params(labelsize=7)
     return sc
 
@@ -133,6 +133,7 @@ def figure(df: pd.DataFrame) -> Figure:
     import matplotlib.pyplot as plt
 
     ok = df[df.status == "ok"]
+    ended = ok.at_rest.astype(bool) | (ok.end_time_s >= FINAL) if len(ok) else pd.Series(dtype=bool)
     surface, line = benchmarks.data(DATA, "final_surface"), benchmarks.data(DATA, "failure_line")
     fig = plt.figure(figsize=(13, 8.5))
     grid = fig.add_gridspec(3, 4, height_ratios=[1, 1, 1.6])
@@ -144,7 +145,9 @@ def figure(df: pd.DataFrame) -> Figure:
         shown = [min(states, key=lambda s: abs(s[0] - t)) for t in SNAPSHOTS if t <= final_t] + [states[-1]]
         for k, (t, f) in enumerate(shown[:4]):
             ax = fig.add_subplot(grid[k // 2, 2 * (k % 2):2 * (k % 2) + 2])
-            label = f"{main.grid}: t = {t:.2f} s" + (" (final)" if k == len(shown) - 1 else "")
+            last = k == len(shown) - 1
+            label = f"{main.grid}: t = {t:.2f} s" + ((" (final)" if ended.iloc[min(1, len(ok) - 1)] else
+                                                      " (mid-flow: the run stops here)") if last else "")
             sc = _draw(ax, meshio.read(f), vmax, label)
         fig.colorbar(sc, ax=fig.axes, shrink=0.5, label="displacement (m)", location="right")
     ax = fig.add_subplot(grid[2, :3])
@@ -153,11 +156,15 @@ def figure(df: pd.DataFrame) -> Figure:
     ax.plot([0, 0.2, 0.2], [0.1, 0.1, 0], "k:", lw=0.8, label="initial column")
     for _, r in ok.iterrows():
         p, fl = json.loads(r.profile), np.array(json.loads(r.failure))
-        ax.plot(p["x"], p["h"], "-", lw=1.2, label=f"{r.grid} ({r.nodes} nodes): surface, run-out {r.run_out_m:.3f} m")
+        ax.plot(p["x"], p["h"], "-", lw=1.2, label=f"{r.grid} ({r.nodes} nodes): surface at t = {r.end_time_s:.2g} s, "
+                                                  f"run-out {r.run_out_m:.3f} m")
         if len(fl):
             ax.plot(fl[:, 0], fl[:, 1], "--", lw=1, color=ax.lines[-1].get_color(),
                     label=f"{r.grid}: static region (|u| < {STATIC * 1e3:g} mm)")
-    ax.set(xlabel="x (m)", ylabel="y (m)", xlim=(0, 0.5), ylim=(0, 0.11), aspect="equal", title=TITLE)
+    title = TITLE if len(ok) and ended.all() else (
+        f"Granular column collapse: the surface at t = {ok.end_time_s.max() if len(ok) else 0:.2g} s (mid-flow, not a "
+        "deposit) beside Bui et al.'s (2008) final deposit")
+    ax.set(xlabel="x (m)", ylabel="y (m)", xlim=(0, 0.5), ylim=(0, 0.11), aspect="equal", title=title)
     ax.legend(fontsize=6, loc="upper right")
     ax.grid(True, alpha=0.3)
     ax = fig.add_subplot(grid[2, 3])
@@ -166,7 +173,7 @@ def figure(df: pd.DataFrame) -> Figure:
         ax.plot(ok.nodes, ok.height_at_wall_m, "s-", label="height at the wall (m)")
         ax.axhline(ok.run_out_measured_m.iloc[0], color="C0", ls=":", label="experiment")
         ax.axhline(0.1, color="C1", ls=":")
-    ax.set(xlabel="field nodes", title="against node count")
+    ax.set(xlabel="field nodes", ylabel="length (m)", title="against node count")
     ax.legend(fontsize=7)
     ax.grid(True, alpha=0.3)
     return fig

@@ -92,7 +92,7 @@ def figure(df: pd.DataFrame) -> Figure:
     ax = axes[1]
     if len(ok):
         ax.barh(ok.variant, ok.time_s)
-    ax.set(xlabel="wall time (s)", title="cost")
+    ax.set(xlabel="wall time (s)", ylabel="setting", title="cost")
     ax.tick_params(axis="y", labelsize=7)
     ax.grid(True, alpha=0.3)
     fig.suptitle(TITLE)

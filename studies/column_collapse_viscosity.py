@@ -72,7 +72,8 @@ def figure(df: pd.DataFrame) -> Figure:
         ax.semilogx(x, ok.run_out_m - ok.run_out_measured_m, "s-", label="run-out - measured (m)")
         ax.axhline(0.01, color="k", ls=":", lw=0.8, label="0.01 m")
         ax.axhline(0.0, color="k", lw=0.5)
-    ax.set(xlabel="beta (s; 0 drawn at 1e-7)", title="against the experiment")
+    ax.set(xlabel="viscosity beta (s; 0 drawn at 1e-7)", ylabel="distance from the experiment (m)",
+           title="against the experiment")
     ax.legend(fontsize=7)
     ax.grid(True, alpha=0.3)
     fig.tight_layout()

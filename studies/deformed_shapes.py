@@ -55,8 +55,8 @@ def run(quick: bool = True, out_dir: Path = Path("reports"), progress: Callable[
         _draw(axes[0, 1], tip, step, colour, f"lambda = {step['load_factor'] * lam:.3g}")
         exact = elastica.tip_load_elliptic(step["load_factor"] * lam)
         axes[0, 1].plot(10 * (1 - exact.u_over_L), -10 * exact.w_over_L, "kx")
-    axes[0, 0].set(title="End moment (cf. Fig. 17); x: exact tip", xlabel="x", ylabel="y", aspect="equal")
-    axes[0, 1].set(title="Tip load (cf. Fig. 15); x: exact tip", xlabel="x", ylabel="y", aspect="equal")
+    axes[0, 0].set(title="End moment (cf. Fig. 17); x: exact tip", xlabel="x (m)", ylabel="y (m)", aspect="equal")
+    axes[0, 1].set(title="Tip load (cf. Fig. 15); x: exact tip", xlabel="x (m)", ylabel="y (m)", aspect="equal")
     finished(fig, axes, "major", 7)
     return save_figure(fig, Path(out_dir) / f"{NAME}.png")
 

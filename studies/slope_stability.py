@@ -72,7 +72,8 @@ def figure(df: pd.DataFrame) -> Figure:
     ax.plot([], [], "-", lw=6, color="tab:orange", label="scikit-fem P2 [stable, failed]")
     ax.plot([], [], "k-", label="Bishop's simplified method (ours)")
     ax.set_xticks(range(len(labels)), labels, fontsize=7)
-    ax.set(ylabel="factor of safety (SRF)", title=TITLE, ylim=(1.25, 1.45))
+    ax.set(xlabel="benchmark, method and node count", ylabel="factor of safety (SRF)", title=TITLE,
+           ylim=(1.25, 1.45))
     return finished(fig, axes)
 
 
