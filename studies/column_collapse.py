@@ -162,8 +162,8 @@ def figure(df: pd.DataFrame) -> Figure:
             ax.plot(fl[:, 0], fl[:, 1], "--", lw=1, color=ax.lines[-1].get_color(),
                     label=f"{r.grid}: static region (|u| < {STATIC * 1e3:g} mm)")
     title = TITLE if len(ok) and ended.all() else (
-        f"Granular column collapse: the surface at t = {ok.end_time_s.max() if len(ok) else 0:.2g} s (mid-flow, not a "
-        "deposit) beside Bui et al.'s (2008) final deposit")
+        f"Column collapse at t = {ok.end_time_s.max() if len(ok) else 0:.2g} s (mid-flow, not a deposit)\n"
+        "beside the final deposit of Bui et al. (2008)")
     ax.set(xlabel="x (m)", ylabel="y (m)", xlim=(0, 0.5), ylim=(0, 0.11), aspect="equal", title=title)
     ax.legend(fontsize=6, loc="upper right")
     ax.grid(True, alpha=0.3)
