@@ -58,9 +58,9 @@ def figure(df: pd.DataFrame) -> Figure:
         r = ok.iloc[-1]
         states = read_pvd(Path(r.folder) / "result.pvd")
         first, last = meshio.read(states[0][1]), meshio.read(states[-1][1])
-        head = TITLE if r.cloud != "quick" else (
-            f"Slope at SRF = 1.6, quick run ({r.nodes} nodes, {r.max_displacement_m:.2g} m of displacement; the "
-            "large-deformation slide of Fig. 21 is the full run's)")
+        fig.suptitle(TITLE if r.cloud != "quick" else (
+            f"Slope at SRF = 1.6, quick run: {r.nodes} nodes, {r.max_displacement_m:.2g} m of displacement\n"
+            "(the large-deformation slide of Fig. 21 is the full run's)"))
         for ax, mesh, field, label, title in (
                 (axes[0], first, None, "", "initial configuration"),
                 (axes[1], last, "displacement", "displacement (m)", f"t = {states[-1][0]:.2f} s ({r.steps} steps)"),
@@ -74,7 +74,7 @@ def figure(df: pd.DataFrame) -> Figure:
                         ax.plot(x[e, 0], x[e, 1], "k-", lw=0.5)
             if field:
                 fig.colorbar(sc, ax=ax, label=label)
-            ax.set(aspect="equal", xlim=(-1, 61), ylim=(-1, 16), title=f"{head}: {title}", xlabel="x (m)",
+            ax.set(aspect="equal", xlim=(-1, 61), ylim=(-1, 16), title=title, xlabel="x (m)",
                    ylabel="y (m)")
     fig.tight_layout()
     return fig
