@@ -1,20 +1,27 @@
 """Global stiffness and load vectors from CTM points and RPIM shape functions (Eqs. 5-6).
 
 Degrees of freedom are interleaved: node i owns dofs 2i (u_x) and 2i+1 (u_y). The stiffness is
-built from sparse products of the derivative matrices, K = B^T (w D) B (the paper's Eq. 7 lacks the
-transpose on B; Eq. 9's form is used), never by scattering a dense block per integration point.
-
-With z = dN/dx + i dN/dy per point and node (z~ likewise from the test gradients), two complex products
-give every sum the stiffness needs: Z~^T W Z = (xx - yy) + i (xy + yx) and Z~^H W Z = (xx + yy) + i (xy - yx),
-where xy_ij = sum_p w_p dN~_i/dx dN_j/dy. That is a third less work than three real products, and the
-four 2 x 2 block entries of every node pair then share one sparsity pattern (a BSR matrix).
+K = sum_p w_p B~_p^T D B_p (the paper's Eq. 7 lacks the transpose on B; Eq. 9's form is used), summed
+node row by node row straight into K's CSR arrays by the compiled kernels of
+:mod:`ctmrpim.discretisation.stiffness_kernels`, never by scattering a dense block per integration point;
+small systems in a process where numba has not run yet are assembled by scipy's sparse products instead.
 """
 from __future__ import annotations
+
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
 
+from ctmrpim.discretisation import rpim_kernels
+from ctmrpim.discretisation import stiffness_kernels as kernels
 from ctmrpim.problem.model import Problem
+
+THREADS = 2            # blocks of node rows assembled concurrently
+ROW_BLOCK = 512        # node rows per kernel call on the thread pool
+#: below this many shape-function entries scipy's products are taken, unless numba already runs in the
+#: process (its first kernel call costs 0.2-0.45 s; :data:`ctmrpim.discretisation.rpim.COMPILED_MIN_POINTS`)
+COMPILED_MIN_ENTRIES = 300_000
 
 
 def dof(node: np.ndarray, component: int) -> np.ndarray:
@@ -25,11 +32,62 @@ def dof(node: np.ndarray, component: int) -> np.ndarray:
 def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: np.ndarray,
               test: tuple[sp.csr_matrix, sp.csr_matrix] | None = None) -> sp.csr_matrix:
     """K (2n x 2n) = sum_p B~_p^T D B_p w_p (Eq. 5) from the derivatives ``dNdx``, ``dNdy`` (m, n) at m points
-    with ``weights`` (m,), for one constant D (3, 3) with D[0, 2] = D[1, 2] = 0 (isotropic or orthotropic in
-    its axes). B~ is built from the ``test`` gradients (d~N/dx, d~N/dy) where given (Petrov-Galerkin, not
-    symmetric: :mod:`ctmrpim.discretisation.consistent_integration`), else B~ = B. All matrices must share
-    one sparsity pattern."""
-    _check_axes(D)
+    with ``weights`` (m,), for one constant D (3, 3). B~ is built from the ``test`` gradients (d~N/dx, d~N/dy)
+    where given (Petrov-Galerkin, not symmetric: :mod:`ctmrpim.discretisation.consistent_integration`), else
+    B~ = B. All matrices must share one sparsity pattern. K's pattern is every pair of nodes that share a
+    point (an entry that sums to zero is kept); its column indices are sorted."""
+    m, n = dNdx.shape
+    tdx, tdy = test if test is not None else (dNdx, dNdy)
+    axes = D[0, 2] == 0 and D[1, 2] == 0 and D[2, 0] == 0 and D[2, 1] == 0
+    if axes and np.array_equal(D, D.T) and not rpim_kernels.use_compiled(dNdx.nnz, COMPILED_MIN_ENTRIES):
+        return _stiffness_products(dNdx, dNdy, weights, D, test)
+    for M in (dNdy, tdx, tdy):
+        same = M.indices is dNdx.indices or (np.array_equal(M.indices, dNdx.indices))
+        if M.nnz != dNdx.nnz or not (same and np.array_equal(M.indptr, dNdx.indptr)):
+            raise ValueError("the gradients must share one sparsity pattern")
+    indptr, indices = dNdx.indptr, dNdx.indices     # int32 or int64: the kernels compile for either
+    data = [np.ascontiguousarray(M.data, dtype=float) for M in (dNdx, dNdy, tdx, tdy)]
+    w = np.ascontiguousarray(weights, dtype=float)
+    Dc = np.ascontiguousarray(D, dtype=float)
+    tptr, trow, tent = kernels.transpose_pattern(indptr, indices, n)
+    blocks = [(a, min(a + ROW_BLOCK, n)) for a in range(0, n, ROW_BLOCK)]
+    counts = np.zeros(n, np.int64)
+    _run(lambda ab: kernels.row_counts(indptr, indices, tptr, trow, n, *ab, counts), blocks)
+    node_start = np.zeros(n + 1, np.int64)
+    np.cumsum(counts, out=node_start[1:])
+    nnz = 4 * int(node_start[-1])
+    itype = np.int32 if max(nnz, 2 * n) < 2**31 - 1 else np.int64
+    k_indices = np.empty(nnz, itype)
+    k_data = np.empty(nnz)
+    _run(lambda ab: kernels.stiffness_rows(indptr, indices, *data, w, Dc, tptr, trow, tent, n, node_start, *ab,
+                                           k_indices, k_data), blocks)
+    k_indptr = np.empty(2 * n + 1, itype)
+    k_indptr[0:-1:2] = 4 * node_start[:-1]
+    k_indptr[1::2] = 4 * node_start[:-1] + 2 * counts
+    k_indptr[-1] = nnz
+    K = sp.csr_matrix((k_data, k_indices, k_indptr), shape=(2 * n, 2 * n), copy=False)
+    K.has_sorted_indices = True
+    K.has_canonical_format = True
+    return K
+
+
+def subtract(K: sp.csr_matrix, C: sp.csr_matrix) -> sp.csr_matrix:
+    """K - C, in place on K's arrays where C's entries all lie in K's pattern (the consistency terms of the
+    consistent schemes couple nodes that already share a point), else as a new matrix."""
+    if C.shape != K.shape:
+        raise ValueError("K and C differ in shape")
+    if rpim_kernels.numba_ready() and K.has_sorted_indices and kernels.add_on_pattern(
+            K.indptr, K.indices, K.data, C.indptr, C.indices, np.asarray(C.data, float), -1.0):
+        return K
+    return (K - C).tocsr()
+
+
+def _stiffness_products(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: np.ndarray,
+              test: tuple[sp.csr_matrix, sp.csr_matrix] | None = None) -> sp.csr_matrix:
+    """:func:`stiffness` by scipy's sparse products, for D[0, 2] = D[1, 2] = 0. With z = dN/dx + i dN/dy per
+    point and node (z~ likewise from the test gradients), two complex products give every sum the stiffness
+    needs: Z~^T W Z = (xx - yy) + i (xy + yx) and Z~^H W Z = (xx + yy) + i (xy - yx), a third less work than
+    three real products; the four 2 x 2 block entries of every node pair then share one pattern (BSR)."""
     n = dNdx.shape[1]
     tdx, tdy = test if test is not None else (dNdx, dNdy)
     rows = np.repeat(np.arange(dNdx.shape[0]), np.diff(dNdx.indptr))
@@ -54,11 +112,6 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     return _block_stiffness(pattern, xx, xy, yx, yy, D, n)
 
 
-def _check_axes(D: np.ndarray) -> None:
-    if abs(D[0, 2]) > 0 or abs(D[1, 2]) > 0:
-        raise NotImplementedError("the stiffness assembly assumes D[0, 2] = D[1, 2] = 0 (isotropic or orthotropic)")
-
-
 def _block_stiffness(pattern: sp.csr_matrix, xx: np.ndarray, xy: np.ndarray, yx: np.ndarray, yy: np.ndarray,
                      D: np.ndarray, n: int) -> sp.csr_matrix:
     """K (2n x 2n) from the node-pair sums xx_IJ = sum_p w_p dN_I/dx dN_J/dx (and xy, yx, yy) on ``pattern``:
@@ -78,6 +131,17 @@ def _on_pattern(a: sp.csr_matrix, pattern: sp.csr_matrix) -> np.ndarray:
     out = np.zeros(pattern.nnz, dtype=a.dtype)
     out[np.searchsorted(key(pattern), key(a))] = a.data
     return out
+
+
+def _run(work, blocks: list[tuple[int, int]]) -> None:
+    """``work(block)`` for every block, on a thread pool where there is more than one (the kernels release
+    the GIL)."""
+    if len(blocks) > 1 and THREADS > 1:
+        with ThreadPoolExecutor(max_workers=THREADS) as pool:
+            list(pool.map(work, blocks))
+    else:
+        for ab in blocks:
+            work(ab)
 
 
 def load_vector(N: sp.csr_matrix, weights: np.ndarray, tx: np.ndarray, ty: np.ndarray) -> np.ndarray:

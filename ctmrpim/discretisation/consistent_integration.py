@@ -33,6 +33,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.sparse as sp
 
+from ctmrpim.discretisation import rpim_kernels, vci_kernels
+from ctmrpim.discretisation.assembly import COMPILED_MIN_ENTRIES
 from ctmrpim.discretisation.ctm import BoundaryQuadrature, boundary_points
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator, value_operator
 from ctmrpim.discretisation.rpim import ShapeFunctions
@@ -56,11 +58,6 @@ def boundary_quadrature(nodes: np.ndarray, edges: np.ndarray) -> BoundaryQuadrat
     return q
 
 
-def _entries(M: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
-    """Row and column of every stored entry of a CSR matrix."""
-    return np.repeat(np.arange(M.shape[0]), np.diff(M.indptr)), M.indices
-
-
 def corrected_gradients(nodes: np.ndarray, d_c: float, points: np.ndarray, w: np.ndarray, sf: ShapeFunctions,
                         boundary: BoundaryQuadrature, N_boundary: sp.csr_matrix, order: str
                         ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
@@ -69,10 +66,42 @@ def corrected_gradients(nodes: np.ndarray, d_c: float, points: np.ndarray, w: np
     against the ``boundary`` Gauss points, where ``N_boundary`` (b, n) are the shape functions. ``nodes``
     (n, 2), ``d_c`` the node spacing (it scales q). A node in no point's support keeps its gradients."""
     dx, dy, N = sf.dNdx, sf.dNdy, sf.N
+    if not rpim_kernels.use_compiled(dx.nnz, COMPILED_MIN_ENTRIES):
+        return _numpy_corrected_gradients(nodes, d_c, points, w, sf, boundary, N_boundary, order)
     n = len(nodes)
-    rows, cols = _entries(dx)
+    quadratic = order != "linear"
+    f64 = lambda v: np.ascontiguousarray(v, dtype=float)
+    indptr, indices = dx.indptr, dx.indices          # int32 or int64: the kernels compile for either
+    nodes, points = f64(nodes).reshape(-1, 2), f64(points).reshape(-1, 2)
+    # per-node moments of the integration constraints, one compiled pass over the entries (vci_kernels)
+    M = np.zeros((n, 3, 3))
+    R = np.zeros((n, 3, 2))
+    vci_kernels.moments(indptr, indices, f64(dx.data), f64(dy.data), f64(N.data), f64(w), points, nodes,
+                        float(d_c), quadratic, N_boundary.indptr, N_boundary.indices,
+                        f64(N_boundary.data), f64(boundary.weights), f64(boundary.normals).reshape(-1, 2),
+                        f64(boundary.points).reshape(-1, 2), M, R)
+    c = np.zeros((n, 3, 2))
+    if quadratic:
+        used = M[:, 0, 0] > 0
+        c[used] = np.linalg.solve(M[used], R[used])
+    else:
+        total = M[:, 0, 0]
+        c[:, 0, :] = R[:, 0, :] / np.where(total > 0, total, 1.0)[:, None]
+    out_x, out_y = np.empty(dx.nnz), np.empty(dx.nnz)
+    vci_kernels.corrected(indptr, indices, f64(dx.data), f64(dy.data), points, nodes, float(d_c), quadratic, c,
+                          out_x, out_y)
+    return tuple(sp.csr_matrix((v, d.indices, d.indptr), shape=d.shape) for v, d in ((out_x, dx), (out_y, dy)))
+
+
+def _numpy_corrected_gradients(nodes: np.ndarray, d_c: float, points: np.ndarray, w: np.ndarray, sf: ShapeFunctions,
+                               boundary: BoundaryQuadrature, N_boundary: sp.csr_matrix, order: str
+                               ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """:func:`corrected_gradients` by numpy: weighted ``bincount`` passes over the entries."""
+    dx, dy, N = sf.dNdx, sf.dNdy, sf.N
+    n = len(nodes)
+    rows, cols = np.repeat(np.arange(dx.shape[0]), np.diff(dx.indptr)), dx.indices
     wp = w[rows]
-    brows, bcols = _entries(N_boundary)
+    brows, bcols = np.repeat(np.arange(N_boundary.shape[0]), np.diff(N_boundary.indptr)), N_boundary.indices
     bw = boundary.weights[brows] * N_boundary.data
     if order == "linear":
         total = np.bincount(cols, wp, n)

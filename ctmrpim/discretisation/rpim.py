@@ -6,12 +6,17 @@ For every evaluation point the moment system of Eq. (32),
 
 is solved for the shape-function values and, with the differentiated right-hand sides, their x and y
 derivatives (three right-hand sides at once). G is symmetric, so the row vector of Eq. (33) equals
-G^-1 times the column. All points are solved together: supports are padded to the largest one, each
-padding slot decoupled by an identity row, in chunks that bound memory. Coordinates are local,
-centred at the evaluation point and scaled by d_c; the shape functions do not change under this, and
-the conditioning is far better.
+G^-1 times the column. Coordinates are local, centred at the evaluation point and scaled by d_c; the
+shape functions do not change under this, and the conditioning is far better.
 
-The result is stored as sparse rows (point -> support nodes), ready for B^T D B products.
+The loops over the points are compiled (:mod:`ctmrpim.discretisation.rpim_kernels`): a count pass over
+a cell grid of the nodes sizes the CSR rows, then blocks of points, on a thread pool, each solve their
+systems one point at a time into those rows. Memory is the result plus one system per thread. Small
+sets of points in a process where numba has not run yet take a numpy path instead (numba's start-up
+would cost more than it saves): padded supports solved in batches by LAPACK, chunk by chunk.
+
+The result is stored as sparse rows (point -> support nodes, in increasing node order), ready for
+B^T D B products.
 """
 from __future__ import annotations
 
@@ -23,10 +28,16 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 from threadpoolctl import threadpool_limits
 
+from ctmrpim.discretisation import rpim_kernels as kernels
 from ctmrpim.errors import ProblemError
 
-CHUNK = 128                  # points per batched solve: small enough that (CHUNK, k+m, k+m) stays in cache
-THREADS = 2                  # chunks solved concurrently
+BLOCK = 2048                 # points per kernel call on the thread pool
+THREADS = 2                  # blocks (compiled) or chunks (numpy) solved concurrently
+CHUNK = 128                  # numpy path: points per batched solve, (CHUNK, k+m, k+m) stays in cache
+#: below this many points the numpy path is taken, unless numba is already initialised in the process:
+#: numba's first kernel call costs about 0.2-0.45 s (its lowering registries load, cached kernels or not),
+#: and the compiled path saves about 10-50 us per point (measured on this project's two-core machine)
+COMPILED_MIN_POINTS = 8000
 PARTITION_OF_UNITY_TOL = 1e-6  # sum_i phi_i - 1 beyond this means the moment matrix was numerically singular
 
 
@@ -38,6 +49,111 @@ class ShapeFunctions:
     dNdy: sp.csr_matrix     # (m, n) y derivatives
     support_sizes: np.ndarray  # (m,) nodes in each point's support
     dropped: np.ndarray | None = None   # points left without shape functions (``drop_singular``)
+
+
+def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float, eta: float,
+                    polynomial_terms: int, scale: float, derivatives: bool = True,
+                    tree: cKDTree | None = None,
+                    reference: tuple[np.ndarray, np.ndarray, float] | None = None,
+                    min_nodes: int = 0, drop_singular: bool = False) -> ShapeFunctions:
+    """RPIM shape functions (Eqs. 25-34) of ``nodes`` at ``points``.
+
+    ``support_radius`` and ``scale`` (d_c) are absolute lengths. A point whose support holds fewer
+    nodes than the polynomial needs, or whose moment matrix is singular, is an error naming it.
+    ``reference = (node_positions, point_positions, distance)`` on a deformed cloud drops from a
+    support every node farther than ``distance`` from the point in the reference configuration, so
+    that parts of the body that were far apart (the two ends of a beam rolled into a ring) never
+    share shape functions when they come close. ``min_nodes`` > 0 widens the support of a point that
+    holds fewer nodes than that to its ``min_nodes`` nearest (a flow front, where the cloud thins out:
+    r^eta with eta = 5 is conditionally positive definite of order 3, so with the linear basis a
+    support of a handful of scattered nodes can make the moment matrix singular). ``tree``: a KD-tree
+    of ``nodes``, used only to widen supports (built here when needed and not given).
+    """
+    nodes = np.ascontiguousarray(nodes, dtype=float).reshape(-1, 2)
+    points = np.ascontiguousarray(points, dtype=float).reshape(-1, 2)
+    if not kernels.use_compiled(len(points), COMPILED_MIN_POINTS):
+        return _numpy_shape_functions(nodes, points, support_radius, eta, polynomial_terms, scale, derivatives,
+                                      tree, reference, min_nodes, drop_singular)
+    m = polynomial_terms
+    n_pts = len(points)
+    radius = np.full(n_pts, float(support_radius))
+    grid = kernels.cell_grid(nodes, float(support_radius)) if len(nodes) else None
+    use_ref = reference is not None
+    node_ref, point_ref, far2 = ((np.ascontiguousarray(reference[0], dtype=float),
+                                  np.ascontiguousarray(reference[1], dtype=float), float(reference[2]) ** 2)
+                                 if use_ref else (np.zeros((1, 2)), np.zeros((1, 2)), 0.0))
+    raw = np.zeros(n_pts, np.int64)
+    kept = np.zeros(n_pts, np.int64)
+
+    def count(sel: slice | np.ndarray) -> None:
+        if grid is None:
+            return
+        pr = point_ref if not use_ref else np.ascontiguousarray(point_ref[sel])
+        r_, k_ = np.zeros(len(points[sel]), np.int64), np.zeros(len(points[sel]), np.int64)
+        kernels.support_counts(nodes, *grid, np.ascontiguousarray(points[sel]), radius[sel], node_ref, pr, far2,
+                               use_ref, r_, k_)
+        raw[sel], kept[sel] = r_, k_
+
+    count(slice(None))
+    short = raw < min_nodes
+    if short.any() and min_nodes <= len(nodes):
+        tree = tree if tree is not None else cKDTree(nodes)
+        far = tree.query(points[short], k=min_nodes)[0].reshape(-1, min_nodes)[:, -1]
+        radius[short] = far * (1.0 + 1e-12)
+        count(np.flatnonzero(short))
+    need = m + 1
+    if n_pts and raw.min() < need:
+        i = int(np.argmin(raw))
+        raise ProblemError(
+            f"RPIM: point #{i} at ({points[i, 0]:.6g}, {points[i, 1]:.6g}) has {raw[i]} node(s) within the "
+            f"support radius {support_radius:.6g}; the {'linear' if m == 3 else 'quadratic'} basis needs at least "
+            f"{need}: increase method.support_radius")
+    if use_ref and n_pts and kept.min() < need:
+        i = int(np.flatnonzero(kept < need)[0])
+        raise ProblemError(f"RPIM: point #{i} at ({points[i, 0]:.6g}, {points[i, 1]:.6g}) keeps "
+                           f"{int(kept[i])} node(s) of its support that were its neighbours in the "
+                           "reference configuration; increase method.support_radius")
+    n_out = 3 if derivatives else 1
+    nnz = int(kept.sum())
+    itype = np.int32 if max(nnz, len(nodes)) < 2**31 - 1 else np.int64
+    indptr = np.zeros(n_pts + 1, itype)
+    np.cumsum(kept, out=indptr[1:])
+    indices = np.empty(nnz, itype)
+    values = np.empty((n_out, nnz))
+    status = np.zeros(n_pts, np.int8)
+    if n_pts:
+        args = (nodes, *grid, points, radius, node_ref, point_ref, far2, use_ref, float(eta), m, float(scale),
+                n_out, PARTITION_OF_UNITY_TOL, indptr, indices, values, status)
+        blocks = [(a, min(a + BLOCK, n_pts)) for a in range(0, n_pts, BLOCK)]
+        if len(blocks) > 1 and THREADS > 1:
+            with ThreadPoolExecutor(max_workers=THREADS) as pool:
+                list(pool.map(lambda ab: kernels.rpim_rows(*args, *ab), blocks))
+        else:  # one block (tractions, probes): no pool to start
+            for ab in blocks:
+                kernels.rpim_rows(*args, *ab)
+    bad = status != kernels.OK
+    if bad.any():
+        if not drop_singular:
+            raise _singular_error(points, int(np.flatnonzero(bad)[0]))
+        keep = np.repeat(~bad, kept)
+        kept = np.where(bad, 0, kept)
+        indptr[1:] = np.cumsum(kept)
+        indices, values = indices[keep], values[:, keep]
+    shape = (n_pts, len(nodes))
+    mats = [_csr(values[j], indices, indptr, shape) for j in range(n_out)]
+    if not derivatives:
+        mats += [None, None]
+    sizes = kept.astype(np.int64)
+    return ShapeFunctions(N=mats[0], dNdx=mats[1], dNdy=mats[2], support_sizes=sizes,
+                          dropped=np.flatnonzero(sizes == 0) if drop_singular else None)
+
+
+def _csr(data: np.ndarray, indices: np.ndarray, indptr: np.ndarray, shape: tuple[int, int]) -> sp.csr_matrix:
+    """A CSR matrix on arrays known to be canonical (sorted, unique column indices per row): no checks, no copies."""
+    M = sp.csr_matrix((data, indices, indptr), shape=shape, copy=False)
+    M.has_sorted_indices = True
+    M.has_canonical_format = True
+    return M
 
 
 def _powr(r2: np.ndarray, p: float) -> np.ndarray:
@@ -64,23 +180,14 @@ def _polynomial(x: np.ndarray, y: np.ndarray, m: int) -> np.ndarray:
     return np.stack(cols, axis=-1)
 
 
-def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float, eta: float,
-                    polynomial_terms: int, scale: float, derivatives: bool = True,
-                    tree: cKDTree | None = None,
-                    reference: tuple[np.ndarray, np.ndarray, float] | None = None,
-                    min_nodes: int = 0, drop_singular: bool = False) -> ShapeFunctions:
-    """RPIM shape functions (Eqs. 25-34) of ``nodes`` at ``points``.
-
-    ``support_radius`` and ``scale`` (d_c) are absolute lengths. A point whose support holds fewer
-    nodes than the polynomial needs, or whose moment matrix is singular, is an error naming it.
-    ``reference = (node_positions, point_positions, distance)`` on a deformed cloud drops from a
-    support every node farther than ``distance`` from the point in the reference configuration, so
-    that parts of the body that were far apart (the two ends of a beam rolled into a ring) never
-    share shape functions when they come close. ``min_nodes`` > 0 widens the support of a point that
-    holds fewer nodes than that to its ``min_nodes`` nearest (a flow front, where the cloud thins out:
-    r^eta with eta = 5 is conditionally positive definite of order 3, so with the linear basis a
-    support of a handful of scattered nodes can make the moment matrix singular).
-    """
+def _numpy_shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float, eta: float,
+                           polynomial_terms: int, scale: float, derivatives: bool = True,
+                           tree: cKDTree | None = None,
+                           reference: tuple[np.ndarray, np.ndarray, float] | None = None,
+                           min_nodes: int = 0, drop_singular: bool = False) -> ShapeFunctions:
+    """:func:`shape_functions` by numpy: points padded to their chunk's largest support, each padding slot
+    decoupled by an identity row, and solved in batches by LAPACK (``CHUNK`` points at a time, on the
+    thread pool); rows in each point's support in distance order."""
     nodes = np.asarray(nodes, float)
     points = np.asarray(points, float)
     m = polynomial_terms
@@ -199,7 +306,7 @@ def _chunk(nodes, pts, point_ids, tree, k, radius, eta, m, scale, derivatives, r
         phi = np.linalg.solve(G, rhs)[:, :k, :]
     except np.linalg.LinAlgError:
         if not drop:
-            raise _singular_error(pts, point_ids, _first_singular(G)) from None
+            raise _singular_error(pts, _first_singular(G), point_ids) from None
         singular = _singular(G)
         G[singular] = np.eye(size)
         phi = np.linalg.solve(G, rhs)[:, :k, :]
@@ -210,7 +317,7 @@ def _chunk(nodes, pts, point_ids, tree, k, radius, eta, m, scale, derivatives, r
     if bad.any():
         if not drop:
             i = int(np.flatnonzero(bad)[0])
-            raise _singular_error(pts, point_ids, i)
+            raise _singular_error(pts, i, point_ids)
         valid[bad] = False
     vals = np.moveaxis(phi, 2, 0)[:, valid]                       # (n_out, nnz), row-major
     if derivatives:
@@ -233,7 +340,9 @@ def _first_singular(G: np.ndarray) -> int:
     return int(np.argmax(_singular(G)))
 
 
-def _singular_error(pts: np.ndarray, point_ids: np.ndarray, i: int) -> ProblemError:
+def _singular_error(pts: np.ndarray, i: int, where: np.ndarray | None = None) -> ProblemError:
+    """The error naming point #i at pts[i] (#where[i] of the caller's points where given)."""
+    name = i if where is None else int(where[i])
     return ProblemError(
-        f"RPIM: the moment matrix of point #{point_ids[i]} at ({pts[i, 0]:.6g}, {pts[i, 1]:.6g}) is singular "
+        f"RPIM: the moment matrix of point #{name} at ({pts[i, 0]:.6g}, {pts[i, 1]:.6g}) is singular "
         "(nodes in its support collinear, or eta an even integer); increase method.support_radius or change method.eta")

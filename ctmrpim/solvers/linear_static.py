@@ -37,7 +37,8 @@ def consistent_stiffness(case: Case, conf: Configuration, tags: BoundaryTags, D:
     thickness = case.problem.thickness
     boundary, sf_b, test_dx, test_dy = consistent_integration.corrected_test_gradients(conf, case.method, thickness)
     K = assembly.stiffness(conf.sf.dNdx, conf.sf.dNdy, conf.w, D, test=(test_dx, test_dy))
-    return K - consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, boundary, sf_b, D, thickness)
+    return assembly.subtract(K, consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, boundary, sf_b, D,
+                                                                             thickness))
 
 
 def nodal_stiffness_and_load(case: Case, conf: Configuration, tags: BoundaryTags, D: np.ndarray
@@ -53,7 +54,8 @@ def nodal_stiffness_and_load(case: Case, conf: Configuration, tags: BoundaryTags
     q = nodal.boundary
     trial = ShapeFunctions(nodal.N_boundary, nodal.bx[nodal.owner], nodal.by[nodal.owner], np.zeros(0))
     K = assembly.stiffness(nodal.bx, nodal.by, conf.w, D)
-    K = K - consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, q, trial, D, thickness)
+    K = assembly.subtract(K, consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, q, trial, D,
+                                                                          thickness))
     tx, ty = tractions_at(case.problem, conf.x, q, conf.lengths.match_tolerance)
     return K, assembly.load_vector(nodal.N_boundary, q.weights * thickness, tx, ty)
 

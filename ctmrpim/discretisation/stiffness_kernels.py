@@ -1,0 +1,146 @@
+"""Compiled (numba) assembly of K = sum_p w_p B~_p^T D B_p (Eq. 5, in Eq. 9's form) on one sparse pattern.
+
+Why compiled: as scipy products the stiffness takes sparse matrix products over the points (each with a
+symbolic pass, a numeric pass and the output sorted afterwards), then a block matrix and its conversion,
+several copies of K at once. Here it is a row-by-row (Gustavson) product straight into the interleaved CSR
+of K: the points' rows are transposed once into node -> (point, entry) lists by a counting sort; a symbolic
+pass counts each node row's neighbours (nodes sharing a point with it), so K's arrays are allocated once at
+their final size; the numeric pass accumulates, for node I and every node J sharing a point with it, the
+four sums
+
+    xx_IJ = sum_p w_p dN~_I/dx dN_J/dx,  xy_IJ = sum_p w_p dN~_I/dx dN_J/dy,  yx_IJ, yy_IJ likewise,
+
+in a dense accumulator of the row's length, and writes the 2 x 2 block B~_I^T D B_J of every pair (any
+symmetric or non-symmetric 3 x 3 D). Rows are independent, so blocks of rows run on a thread pool (the
+kernels release the GIL). Working memory is K's arrays plus two integer arrays of the node count per
+thread; nothing of size points x support x support exists.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_FAST = {"contract", "reassoc"}
+
+
+@njit(cache=True, nogil=True)
+def transpose_pattern(indptr, indices, n):
+    """The columns of a CSR pattern (m rows, ``n`` columns) as lists: (start of each column (n + 1), row of
+    each entry in column order, entry index into ``indices``); rows ascending within a column."""
+    m = len(indptr) - 1
+    tptr = np.zeros(n + 1, np.int64)
+    for k in range(len(indices)):
+        tptr[indices[k] + 1] += 1
+    for j in range(n):
+        tptr[j + 1] += tptr[j]
+    fill = tptr[:-1].copy()
+    trow = np.empty(len(indices), np.int64)
+    tent = np.empty(len(indices), np.int64)
+    for p in range(m):
+        for k in range(indptr[p], indptr[p + 1]):
+            j = indices[k]
+            t = fill[j]
+            trow[t] = p
+            tent[t] = k
+            fill[j] = t + 1
+    return tptr, trow, tent
+
+
+@njit(cache=True, nogil=True)
+def row_counts(indptr, indices, tptr, trow, n, r0, r1, counts):
+    """counts[I] for r0 <= I < r1: how many nodes J share an integration point with node I."""
+    mark = np.full(n, -1, np.int64)
+    for i in range(r0, r1):
+        c = 0
+        for t in range(tptr[i], tptr[i + 1]):
+            p = trow[t]
+            for k in range(indptr[p], indptr[p + 1]):
+                j = indices[k]
+                if mark[j] != i:
+                    mark[j] = i
+                    c += 1
+        counts[i] = c
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n, node_start, r0, r1,
+                   k_indices, k_data):
+    """Rows 2I and 2I + 1 of K for r0 <= I < r1 into the interleaved CSR arrays: node row I owns
+    4 node_start[I] .. 4 node_start[I + 1] (its c neighbours: row 2I first, 2c entries, then row 2I + 1),
+    columns 2J, 2J + 1 for J ascending. (dx, dy) the trial and (tdx, tdy) the test gradients on the pattern
+    (indptr, indices), w the points' weights, D (3, 3)."""
+    mark = np.full(n, -1, np.int64)
+    pos = np.empty(n, np.int64)
+    width = 0
+    for i in range(r0, r1):
+        width = max(width, node_start[i + 1] - node_start[i])
+    cols = np.empty(width, np.int64)
+    xx = np.empty(width)
+    xy = np.empty(width)
+    yx = np.empty(width)
+    yy = np.empty(width)
+    d00, d01, d02 = D[0, 0], D[0, 1], D[0, 2]
+    d10, d11, d12 = D[1, 0], D[1, 1], D[1, 2]
+    d20, d21, d22 = D[2, 0], D[2, 1], D[2, 2]
+    for i in range(r0, r1):
+        c = 0
+        for t in range(tptr[i], tptr[i + 1]):
+            p = trow[t]
+            for k in range(indptr[p], indptr[p + 1]):
+                j = indices[k]
+                if mark[j] != i:
+                    mark[j] = i
+                    cols[c] = j
+                    c += 1
+        cs = np.sort(cols[:c])
+        for q in range(c):
+            pos[cs[q]] = q
+            xx[q] = 0.0
+            xy[q] = 0.0
+            yx[q] = 0.0
+            yy[q] = 0.0
+        for t in range(tptr[i], tptr[i + 1]):
+            p = trow[t]
+            e = tent[t]
+            ax = tdx[e] * w[p]
+            ay = tdy[e] * w[p]
+            for k in range(indptr[p], indptr[p + 1]):
+                q = pos[indices[k]]
+                bx = dx[k]
+                by = dy[k]
+                xx[q] += ax * bx
+                xy[q] += ax * by
+                yx[q] += ay * bx
+                yy[q] += ay * by
+        o0 = 4 * node_start[i]
+        o1 = o0 + 2 * c
+        for q in range(c):
+            j = cs[q]
+            a, b, g, h = xx[q], xy[q], yx[q], yy[q]
+            # B~_I^T D B_J with B = [[d/dx, 0], [0, d/dy], [d/dy, d/dx]]
+            k_indices[o0 + 2 * q] = 2 * j
+            k_indices[o0 + 2 * q + 1] = 2 * j + 1
+            k_indices[o1 + 2 * q] = 2 * j
+            k_indices[o1 + 2 * q + 1] = 2 * j + 1
+            k_data[o0 + 2 * q] = d00 * a + d02 * b + d20 * g + d22 * h
+            k_data[o0 + 2 * q + 1] = d01 * b + d02 * a + d21 * h + d22 * g
+            k_data[o1 + 2 * q] = d10 * g + d12 * h + d20 * a + d22 * b
+            k_data[o1 + 2 * q + 1] = d11 * h + d12 * g + d21 * b + d22 * a
+
+
+@njit(cache=True, nogil=True)
+def add_on_pattern(indptr, indices, data, c_indptr, c_indices, c_data, scale):
+    """data += scale * C on the pattern (indptr, indices) where every entry of C (CSR, any column order) has
+    a place in it (column indices sorted per row); False, with data unchanged, where one has none."""
+    where = np.empty(len(c_indices), np.int64)
+    for r in range(len(c_indptr) - 1):
+        a, b = indptr[r], indptr[r + 1]
+        for e in range(c_indptr[r], c_indptr[r + 1]):
+            j = c_indices[e]
+            k = a + np.searchsorted(indices[a:b], j)
+            if k >= b or indices[k] != j:
+                return False
+            where[e] = k
+    for e in range(len(c_indices)):
+        data[where[e]] += scale * c_data[e]
+    return True

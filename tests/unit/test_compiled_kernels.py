@@ -1,0 +1,200 @@
+"""The compiled linear-path kernels (issue 20) against independent dense forms: the RPIM moment systems solved
+point by point with LAPACK, the stiffness summed point by point as B~^T D B, the corrected test gradients
+against the integration constraints they must make hold; the numpy paths that small problems take against
+them; and the memory they hold. Every test here takes the compiled path (thresholds set to zero) unless it
+says otherwise."""
+from __future__ import annotations
+
+import tracemalloc
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from clouds import cloud
+
+from ctmrpim.discretisation import assembly, rpim
+from ctmrpim.discretisation.consistent_integration import boundary_quadrature, corrected_gradients
+from ctmrpim.discretisation.rpim import shape_functions
+from studies.tolerances import entry
+
+ROUNDOFF = entry("roundoff")["max"]
+
+
+@pytest.fixture(autouse=True)
+def compiled(monkeypatch):
+    monkeypatch.setattr(rpim, "COMPILED_MIN_POINTS", 0)
+    monkeypatch.setattr(assembly, "COMPILED_MIN_ENTRIES", 0)
+    monkeypatch.setattr("ctmrpim.discretisation.consistent_integration.COMPILED_MIN_ENTRIES", 0)
+
+
+def _numpy_paths(monkeypatch):
+    """Force the numpy paths, as in a small run before numba has started."""
+    monkeypatch.setattr(rpim, "COMPILED_MIN_POINTS", 10**12)
+    monkeypatch.setattr(assembly, "COMPILED_MIN_ENTRIES", 10**12)
+    monkeypatch.setattr("ctmrpim.discretisation.consistent_integration.COMPILED_MIN_ENTRIES", 10**12)
+    monkeypatch.setattr("ctmrpim.discretisation.rpim_kernels.numba_ready", lambda: False)
+
+
+@pytest.fixture(scope="module")
+def jittered():
+    geometry, nodes, d_c = cloud("plate-with-hole", jitter=0.3, seed=4)
+    rng = np.random.default_rng(5)
+    x0, y0, x1, y1 = geometry.bounds
+    pts = np.c_[rng.uniform(x0, x1, 300), rng.uniform(y0, y1, 300)]
+    return nodes, pts[geometry.distance_outside(pts) == 0], d_c
+
+
+def _dense_rpim(nodes, x, support, eta, m, d_c):
+    """phi, dphi/dx, dphi/dy of Eq. (33) at x by numpy's dense solve of Eq. (32), in global coordinates."""
+    X = nodes[support]
+    r = np.linalg.norm(X[:, None] - X[None], axis=-1)
+    P = np.c_[np.ones(len(X)), X, *(() if m == 3 else (X[:, 0] ** 2, X[:, 0] * X[:, 1], X[:, 1] ** 2))]
+    G = np.block([[r ** eta, P], [P.T, np.zeros((m, m))]])
+    d = X - x
+    q = np.linalg.norm(d, axis=1)
+    px, py = x
+    p = [1, px, py, px * px, px * py, py * py][:m]
+    dpx = [0, 1, 0, 2 * px, py, 0][:m]
+    dpy = [0, 0, 1, 0, px, 2 * py][:m]
+    rhs = np.c_[np.r_[q ** eta, p], np.r_[-eta * q ** (eta - 2) * d[:, 0], dpx],
+                np.r_[-eta * q ** (eta - 2) * d[:, 1], dpy]]
+    return np.linalg.solve(G, rhs)[:len(X)].T
+
+
+@pytest.mark.parametrize("m", [3, 6])
+def test_shape_functions_match_a_dense_solve_per_point(jittered, m: int) -> None:
+    nodes, pts, d_c = jittered
+    sf = shape_functions(nodes, pts, 4 * d_c, 5.0, m, d_c)
+    for i in range(0, len(pts), 7):
+        support = sf.N.indices[sf.N.indptr[i]:sf.N.indptr[i + 1]]
+        assert np.all(np.diff(support) > 0)                        # increasing node order
+        inside = np.flatnonzero(np.linalg.norm(nodes - pts[i], axis=1) <= 4 * d_c)
+        assert np.array_equal(support, inside)
+        phi, dx, dy = _dense_rpim(nodes, pts[i], support, 5.0, m, d_c)
+        # the dense solve in global coordinates is the worse conditioned one: 1e3 x round-off
+        assert np.abs(sf.N.getrow(i).data - phi).max() <= 1e3 * ROUNDOFF
+        assert np.abs(sf.dNdx.getrow(i).data - dx).max() <= 1e3 * ROUNDOFF / d_c
+        assert np.abs(sf.dNdy.getrow(i).data - dy).max() <= 1e3 * ROUNDOFF / d_c
+
+
+def test_shape_functions_on_more_points_than_one_block(jittered) -> None:
+    """Blocks on the thread pool write disjoint rows: the same rows as one point at a time."""
+    from ctmrpim.discretisation import rpim
+    nodes, _, d_c = jittered
+    rng = np.random.default_rng(8)
+    pts = nodes[rng.integers(0, len(nodes), rpim.BLOCK + 500)] + rng.uniform(-0.3, 0.3, (rpim.BLOCK + 500, 2)) * d_c
+    pts = pts[cloud("plate-with-hole")[0].distance_outside(pts) == 0]
+    full = shape_functions(nodes, pts, 4 * d_c, 5.0, 3, d_c)
+    part = shape_functions(nodes, pts[-300:], 4 * d_c, 5.0, 3, d_c)
+    assert np.array_equal(full.dNdx[-300:].toarray(), part.dNdx.toarray())
+
+
+def _dense_stiffness(dNdx, dNdy, w, D, tdx, tdy):
+    n = dNdx.shape[1]
+    K = np.zeros((2 * n, 2 * n))
+    for p in range(dNdx.shape[0]):
+        B = np.zeros((3, 2 * n))
+        Bt = np.zeros((3, 2 * n))
+        for M, (bx, by) in ((B, (dNdx, dNdy)), (Bt, (tdx, tdy))):
+            gx, gy = bx.getrow(p).toarray()[0], by.getrow(p).toarray()[0]
+            M[0, 0::2], M[1, 1::2], M[2, 0::2], M[2, 1::2] = gx, gy, gy, gx
+        K += w[p] * Bt.T @ D @ B
+    return K
+
+
+@pytest.mark.parametrize("general", [False, True], ids=["isotropic-symmetric", "general-D-petrov-galerkin"])
+def test_stiffness_matches_a_dense_sum_over_points(general: bool) -> None:
+    _, nodes, d_c = cloud("rectangle")
+    rng = np.random.default_rng(3)
+    pts = np.c_[rng.uniform(0, 4, 120), rng.uniform(0, 1, 120)]
+    sf = shape_functions(nodes, pts, 3 * d_c, 5.0, 3, d_c)
+    w = rng.uniform(0.5, 1.5, len(pts))
+    D = np.array([[3.0, 1.0, 0.0], [1.0, 3.0, 0.0], [0.0, 0.0, 1.0]])
+    test = None
+    if general:
+        D = D + rng.uniform(-0.3, 0.3, (3, 3))
+        test = tuple(sp.csr_matrix((M.data + rng.standard_normal(M.nnz), M.indices, M.indptr), shape=M.shape)
+                     for M in (sf.dNdx, sf.dNdy))
+    K = assembly.stiffness(sf.dNdx, sf.dNdy, w, D, test=test)
+    ref = _dense_stiffness(sf.dNdx, sf.dNdy, w, D, *(test or (sf.dNdx, sf.dNdy)))
+    assert K.has_sorted_indices and np.all(np.diff(K.indices[K.indptr[0]:K.indptr[1]]) > 0)
+    assert np.abs(K.toarray() - ref).max() <= ROUNDOFF * np.abs(ref).max()
+
+
+def test_subtract_in_place_on_the_pattern_or_as_a_new_matrix() -> None:
+    K = sp.csr_matrix(np.array([[4.0, 1.0, 0.0], [1.0, 4.0, 1.0], [0.0, 1.0, 4.0]]))
+    C = sp.csr_matrix(([0.5, 0.25], ([0, 1], [1, 2])), shape=(3, 3))
+    expected = K.toarray() - C.toarray()
+    out = assembly.subtract(K, C)
+    assert out is K and np.array_equal(out.toarray(), expected)
+    C2 = sp.csr_matrix(([0.5], ([0], [2])), shape=(3, 3))          # outside K's pattern
+    expected = K.toarray() - C2.toarray()
+    out = assembly.subtract(K, C2)
+    assert out is not K and np.array_equal(out.toarray(), expected)
+
+
+@pytest.mark.parametrize("order", ["linear", "quadratic"])
+def test_corrected_gradients_meet_the_integration_constraints(order: str) -> None:
+    """sum_p w_p (d~_k N_I q_a + N_I d_k q_a) = sum_b w_b N_I q_a n_k for every node I (q = 1 when linear)."""
+    from ctmrpim.discretisation.alpha_shape import alpha_shape
+    from ctmrpim.discretisation.ctm import integration_points
+    geometry, nodes, d_c = cloud("plate-with-hole", jitter=0.2, seed=2)
+    boundary = alpha_shape(nodes, 1.5, d_c, inside=geometry.contains)
+    quad = integration_points(boundary.loop_coordinates(), d_c / 3, d_c / 3, 1, mode="uniform")
+    sf = shape_functions(nodes, quad.points, 4 * d_c, 5.0, 3, d_c)
+    bq = boundary_quadrature(nodes, boundary.edges)
+    Nb = shape_functions(nodes, bq.points, 4 * d_c, 5.0, 3, d_c, derivatives=False).N
+    tx, ty = corrected_gradients(nodes, d_c, quad.points, quad.weights, sf, bq, Nb, order)
+    w = quad.weights
+    qs = [lambda P: np.ones(len(P))]
+    dq = [(0.0, 0.0)]
+    if order == "quadratic":
+        qs += [lambda P, i=0: P[:, i], lambda P, i=1: P[:, i]]      # q_a up to the per-node shift and 1 / d_c
+        dq += [(1.0, 0.0), (0.0, 1.0)]
+    for q, (dqx, dqy) in zip(qs, dq, strict=True):
+        # with the shifted q_I = (x - x_I) / d_c the constraints are linear combinations of those with 1, x, y
+        for k, (T, dk) in enumerate(((tx, dqx), (ty, dqy))):
+            lhs = T.T @ (w * q(quad.points)) + sf.N.T @ (w * dk)
+            rhs = Nb.T @ (bq.weights * q(bq.points) * bq.normals[:, k])
+            assert np.abs(lhs - rhs).max() <= 1e3 * ROUNDOFF * max(np.abs(rhs).max(), 1.0)
+
+
+def test_shape_function_memory_is_the_result_plus_a_little(jittered) -> None:
+    """Nothing of size points x support x support: the traced peak stays within twice the CSR rows' size."""
+    nodes, _, d_c = jittered
+    rng = np.random.default_rng(6)
+    pts = nodes[rng.integers(0, len(nodes), 6000)] + rng.uniform(-0.2, 0.2, (6000, 2)) * d_c
+    pts = pts[cloud("plate-with-hole")[0].distance_outside(pts) == 0]
+    shape_functions(nodes, pts[:10], 4 * d_c, 5.0, 3, d_c)      # kernels loaded
+    tracemalloc.start()
+    sf = shape_functions(nodes, pts, 4 * d_c, 5.0, 3, d_c)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    result = sf.N.nnz * (3 * 8 + sf.N.indices.itemsize)
+    assert peak <= 2 * result
+
+
+def test_numpy_paths_give_the_compiled_results(jittered, monkeypatch) -> None:
+    """Shape functions, corrected gradients and stiffness of both paths agree to round-off."""
+    from ctmrpim.discretisation.alpha_shape import alpha_shape
+    from ctmrpim.discretisation.ctm import integration_points
+    geometry, nodes, d_c = cloud("plate-with-hole", jitter=0.3, seed=4)
+    boundary = alpha_shape(nodes, 1.5, d_c, inside=geometry.contains)
+    quad = integration_points(boundary.loop_coordinates(), d_c / 3, d_c / 3, 1, mode="uniform")
+    bq = boundary_quadrature(nodes, boundary.edges)
+    D = np.array([[3.0, 1.0, 0.0], [1.0, 3.0, 0.0], [0.0, 0.0, 1.0]])
+
+    def run():
+        sf = shape_functions(nodes, quad.points, 4 * d_c, 5.0, 3, d_c)
+        Nb = shape_functions(nodes, bq.points, 4 * d_c, 5.0, 3, d_c, derivatives=False).N
+        test = corrected_gradients(nodes, d_c, quad.points, quad.weights, sf, bq, Nb, "quadratic")
+        return sf, test, assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights, D, test=test)
+
+    sf1, t1, K1 = run()
+    _numpy_paths(monkeypatch)
+    sf0, t0, K0 = run()
+    assert not sf0.N.has_sorted_indices or not np.array_equal(sf0.N.indices, sf1.N.indices)  # really the other path
+    for a, b, scale in ((sf0.N, sf1.N, 1.0), (sf0.dNdx, sf1.dNdx, 1 / d_c), (t0[0], t1[0], 1 / d_c),
+                        (t0[1], t1[1], 1 / d_c)):
+        assert abs(a - b).max() <= ROUNDOFF * scale
+    assert abs(K0 - K1).max() <= ROUNDOFF * abs(K0).max()
