@@ -144,3 +144,67 @@ def add_on_pattern(indptr, indices, data, c_indptr, c_indices, c_data, scale):
     for e in range(len(c_indices)):
         data[where[e]] += scale * c_data[e]
     return True
+
+
+@njit(cache=True, nogil=True)
+def constrained_csc(indptr, indices, data, new, values_at, rhs):
+    """The free-free block of a CSR matrix as CSC arrays, in one pass each way: ``new[i]`` the free index of
+    row/column i or -1 where it is prescribed; rhs[new[r]] -= sum over prescribed columns c of A[r, c]
+    values_at[c] (the prescribed values moved to the right-hand side). Row indices ascend in each column."""
+    nf = 0
+    for i in range(len(new)):
+        if new[i] >= 0:
+            nf += 1
+    cptr = np.zeros(nf + 1, np.int64)
+    for r in range(len(indptr) - 1):
+        if new[r] < 0:
+            continue
+        for k in range(indptr[r], indptr[r + 1]):
+            c = new[indices[k]]
+            if c >= 0:
+                cptr[c + 1] += 1
+    for c in range(nf):
+        cptr[c + 1] += cptr[c]
+    fill = cptr[:-1].copy()
+    rows = np.empty(cptr[nf], indices.dtype)
+    vals = np.empty(cptr[nf])
+    for r in range(len(indptr) - 1):
+        nr = new[r]
+        if nr < 0:
+            continue
+        for k in range(indptr[r], indptr[r + 1]):
+            c = new[indices[k]]
+            if c >= 0:
+                t = fill[c]
+                rows[t] = nr
+                vals[t] = data[k]
+                fill[c] = t + 1
+            else:
+                rhs[nr] -= data[k] * values_at[indices[k]]
+    return cptr, rows, vals
+
+
+@njit(cache=True, nogil=True)
+def lower_bandwidth(indptr, indices, rank):
+    """max(rank[i] - rank[j]) over the entries (i, j) of a CSR or CSC pattern (symmetric: either half)."""
+    bw = 0
+    for r in range(len(indptr) - 1):
+        for k in range(indptr[r], indptr[r + 1]):
+            d = rank[r] - rank[indices[k]]
+            if d > bw:
+                bw = d
+            elif -d > bw:
+                bw = -d
+    return bw
+
+
+@njit(cache=True, nogil=True)
+def fill_lower_band(indptr, indices, data, rank, ab):
+    """LAPACK's lower band storage of the symmetrically permuted matrix, ab[i - j, j] = A[i, j] for i >= j in
+    the permuted numbering ``rank``, from a CSR or CSC matrix with symmetric values (one triangle is read)."""
+    for r in range(len(indptr) - 1):
+        pr = rank[r]
+        for k in range(indptr[r], indptr[r + 1]):
+            pc = rank[indices[k]]
+            if pr >= pc:
+                ab[pr - pc, pc] = data[k]

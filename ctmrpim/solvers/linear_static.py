@@ -20,7 +20,7 @@ from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
 from ctmrpim.reference.error_norms import relative_errors
 from ctmrpim.result import Result, out_of_plane_stress, probe_errors, probe_record
-from ctmrpim.solvers.linear_solver import solve_constrained
+from ctmrpim.solvers.linear_solver import constrained_system, solve_free
 from ctmrpim.timing import Timer
 
 #: Error-norm quadrature: bands and sub-segments at most this many d_c, this many Gauss points each way.
@@ -88,10 +88,13 @@ def solve_ctmrpim(case: Case) -> Result:
 
     # K of the consistent schemes (their Dirichlet terms) is not symmetric: no Cholesky
     symmetric = scheme in ("ctm", "cell-gauss")
-    U = solve_constrained(K, F, fixed, fixed_values, "superlu" if not symmetric and method.solver in ("auto", "banded")
-                          else method.solver)
+    n_dofs, k_nnz = K.shape[0], int(K.nnz)
+    system = constrained_system(K, F, fixed, fixed_values)
+    del K     # one copy of the stiffness (the free block) while it is factorised
+    U = solve_free(*system, "superlu" if not symmetric and method.solver in ("auto", "banded") else method.solver)
+    del system
     u = U.reshape(-1, 2)
-    timer.lap("solve", free_dofs=K.shape[0] - len(fixed))
+    timer.lap("solve", free_dofs=n_dofs - len(fixed))
 
     # stresses are recovered from the integration points': a raw D B(x) u oscillates at boundaries
     point_stress = assembly.strain(sf.dNdx, sf.dNdy, u) @ D.T
@@ -123,7 +126,7 @@ def solve_ctmrpim(case: Case) -> Result:
                 "traction_points": len(traction_q.weights), "boundary_loops": len(boundary.loops),
                 "boundary_nodes": len(tags.boundary_nodes), "holes_filled": boundary.filled_holes,
                 "support_size": {"min": int(sizes.min()), "mean": float(sizes.mean()), "max": int(sizes.max())},
-                "dofs": 2 * len(nodes), "constrained_dofs": len(fixed), "stiffness_nonzeros": int(K.nnz)},
+                "dofs": 2 * len(nodes), "constrained_dofs": len(fixed), "stiffness_nonzeros": k_nnz},
         timings=timer.total(),
         parameters={**case.resolved, "derived": {**conf.lengths.derived(), "tracked_area": boundary.area,
                                                  "geometry_area": problem.geometry.area}},

@@ -198,3 +198,23 @@ def test_numpy_paths_give_the_compiled_results(jittered, monkeypatch) -> None:
                         (t0[1], t1[1], 1 / d_c)):
         assert abs(a - b).max() <= ROUNDOFF * scale
     assert abs(K0 - K1).max() <= ROUNDOFF * abs(K0).max()
+
+
+@pytest.mark.parametrize("solver", ["superlu", "banded"])
+def test_constrained_solve_builds_the_free_block_in_one_pass(monkeypatch, solver: str) -> None:
+    """The compiled free-free block (CSC) and right-hand side give scipy's slicing's solution."""
+    from ctmrpim.solvers import linear_solver
+    rng = np.random.default_rng(0)
+    n = 80
+    A = sp.random(n, n, density=0.15, random_state=1, format="csr")
+    A = (A + A.T + 10 * sp.identity(n)).tocsr()      # symmetric positive definite: both solvers apply
+    A.sort_indices()
+    F, fixed, values = rng.random(n), np.array([0, 5, 7, 30, 79]), rng.random(5)
+    monkeypatch.setattr("ctmrpim.discretisation.rpim_kernels.numba_ready", lambda: True)
+    U1 = linear_solver.solve_constrained(A, F, fixed, values, solver)
+    monkeypatch.setattr("ctmrpim.discretisation.rpim_kernels.numba_ready", lambda: False)
+    U0 = linear_solver.solve_constrained(A, F, fixed, values, solver)
+    assert np.array_equal(U1[fixed], values)
+    free = np.setdiff1d(np.arange(n), fixed)
+    assert np.abs((A @ U1 - F)[free]).max() <= ROUNDOFF * np.abs(F).max()
+    assert np.abs(U1 - U0).max() <= ROUNDOFF * np.abs(U0).max()
