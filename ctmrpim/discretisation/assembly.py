@@ -49,7 +49,9 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     data = [np.ascontiguousarray(M.data, dtype=float) for M in (dNdx, dNdy, tdx, tdy)]
     w = np.ascontiguousarray(weights, dtype=float)
     Dc = np.ascontiguousarray(D, dtype=float)
-    tptr, trow, tent = kernels.transpose_pattern(indptr, indices, n)
+    etype = np.int32 if dNdx.nnz < 2**31 - 1 else np.int64
+    trow, tent = np.empty(dNdx.nnz, etype), np.empty(dNdx.nnz, etype)
+    tptr = kernels.transpose_pattern(indptr, indices, n, trow, tent)
     blocks = [(a, min(a + ROW_BLOCK, n)) for a in range(0, n, ROW_BLOCK)]
     counts = np.zeros(n, np.int64)
     _run(lambda ab: kernels.row_counts(indptr, indices, tptr, trow, n, *ab, counts), blocks)

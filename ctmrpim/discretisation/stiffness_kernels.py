@@ -24,9 +24,10 @@ _FAST = {"contract", "reassoc"}
 
 
 @njit(cache=True, nogil=True)
-def transpose_pattern(indptr, indices, n):
-    """The columns of a CSR pattern (m rows, ``n`` columns) as lists: (start of each column (n + 1), row of
-    each entry in column order, entry index into ``indices``); rows ascending within a column."""
+def transpose_pattern(indptr, indices, n, trow, tent):
+    """The columns of a CSR pattern (m rows, ``n`` columns) as lists: returns the start of each column
+    (n + 1) and fills ``trow`` (the row of each entry in column order) and ``tent`` (its index into
+    ``indices``); rows ascending within a column. The caller sizes trow and tent (int32 where they fit)."""
     m = len(indptr) - 1
     tptr = np.zeros(n + 1, np.int64)
     for k in range(len(indices)):
@@ -34,8 +35,6 @@ def transpose_pattern(indptr, indices, n):
     for j in range(n):
         tptr[j + 1] += tptr[j]
     fill = tptr[:-1].copy()
-    trow = np.empty(len(indices), np.int64)
-    tent = np.empty(len(indices), np.int64)
     for p in range(m):
         for k in range(indptr[p], indptr[p + 1]):
             j = indices[k]
@@ -43,7 +42,7 @@ def transpose_pattern(indptr, indices, n):
             trow[t] = p
             tent[t] = k
             fill[j] = t + 1
-    return tptr, trow, tent
+    return tptr
 
 
 @njit(cache=True, nogil=True)
