@@ -160,6 +160,8 @@ class Loading:
     tangent: str = "consistent"    # Newton's matrix; "elastic" (Mohr-Coulomb only): see solvers.plastic_system
     until_failure: bool = False    # Mohr-Coulomb: a load the body cannot carry ends the run with the limit
                                    # load bracketed (no error); the limit load of a footing
+    limit_slope: float = 0.01      # with until_failure: an increment whose pressure-settlement slope is below this
+                                   # fraction of the elastic one is not carried (0: non-convergence alone decides)
 
     def __post_init__(self) -> None:
         validate("loading", self, self.rules())
@@ -169,6 +171,8 @@ class Loading:
         return [
             ("until_failure", isinstance(self.until_failure, bool), "must be true or false"),
             ("tangent", self.tangent in ("consistent", "elastic"), "must be \"consistent\" or \"elastic\""),
+            ("limit_slope", not isinstance(self.limit_slope, bool) and 0 <= self.limit_slope < 1,
+             "must lie in [0, 1)"),
             ("steps", integer(self.steps, 1), "must be an integer >= 1"),
             ("tolerance", not isinstance(self.tolerance, bool) and 0 < self.tolerance < 1, "must lie in (0, 1)"),
             ("max_iterations", integer(self.max_iterations, 1), "must be an integer >= 1"),
@@ -186,6 +190,9 @@ class StrengthReduction:
     width: float = 0.01             # bisection stops when failed - stable <= width
     max_srf: float = 5.0            # give up (no failure found) beyond this
     steps: int = 4                  # SRF sub-steps per level (halved on non-convergence like load steps)
+    limit_growth: float = 100.0     # search by Newton: a level whose largest displacement from the stable one below,
+                                    # per unit relative SRF rise, exceeds this many times the largest at start has
+                                    # failed (a runaway; 0: non-convergence alone decides)
     values: tuple[float, ...] = field(default=())   # sweep mode: these SRFs, each from zero
 
     def __post_init__(self) -> None:
@@ -201,6 +208,7 @@ class StrengthReduction:
             ("width", 0 < self.width <= self.step, "must be > 0 and at most step"),
             ("max_srf", self.max_srf > self.start, "must exceed start"),
             ("steps", integer(self.steps, 1), "must be an integer >= 1"),
+            ("limit_growth", not isinstance(self.limit_growth, bool) and self.limit_growth >= 0, "must be >= 0"),
             ("values", all(v > 0 for v in self.values), "must all be > 0"),
         ]
 

@@ -16,6 +16,21 @@ and exits with status 3), unless the caller asked for the failure as an answer (
 strength-reduction level). Each iteration is shown by the progress reporter (:mod:`ctmrpim.progress`):
 "increment 3/16 (load factor 0.1875), iteration 2, residual 1.2e-06 of the loads", the increments counted
 as converged ones plus those the current step still needs (so cut-backs raise the total).
+
+A limit load judged by the response (issue 19, item 2): ``judge(factor_a, U_a, factor_b, U_b)``, where given, reads the response of a converged increment from the
+last carried state (a) to the new one (b) and returns why the body has failed there (a response criterion:
+the footing's settlement running away) or None, with entries for the history (the settlement): a failed
+verdict (``converged`` False in the history, ``equilibrium`` True) is treated as a non-converged increment
+(cut back from the carried state, and past the cut-backs the failure), so the bracket [carried, failed]
+closes on the criterion, not on the solver's patience. With a ``judge`` the bracket closes on the step's size,
+not on the count of cut-backs: an increment fails for good when its step is at most 1 / steps halved
+``max_cutbacks`` times (the resolution), and both sides of the bracket are read at that resolution: where
+the last carried increment was longer than ``ROLLBACK`` such steps, its end may already lie past the
+criterion (a long step's secant averages the steep and the flat part of the curve), so the path goes back
+to its start (``restore(snapshot())`` of the state there) and takes it again in halves, the step never
+growing back beyond them. ``recheck``: an increment still not converged when the cut-backs are spent is tried
+once more with twice ``max_iterations`` before its non-convergence counts (then judged like any converged
+one); the history says so.
 """
 from __future__ import annotations
 
@@ -34,6 +49,9 @@ from ctmrpim.problem.settings import Loading
 #: the converged displacement: a mechanism (a failed slope, a footing past its limit load), not slow
 #: convergence, so the increment is cut back at once instead of using up its iterations.
 DIVERGENCE = 100.0
+#: With a response criterion (``judge``): the last carried increment is at most this many of the smallest steps
+#: long, else it is taken again in halves (see :func:`step_loads`).
+ROLLBACK = 4
 
 
 class Anderson:
@@ -88,7 +106,10 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
                assemble: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, sp.spmatrix]],
                solve: Callable[[sp.spmatrix, np.ndarray], np.ndarray],
                on_converged: Callable[[float, np.ndarray], dict[str, Any]], U0: np.ndarray | None = None,
-               stop_on_failure: bool = False, anderson: int = 0) -> LoadPath:
+               stop_on_failure: bool = False, anderson: int = 0,
+               judge: Callable[[float, np.ndarray, float, np.ndarray], tuple[str | None, dict]] | None = None,
+               recheck: bool = False, snapshot: Callable[[], Any] | None = None,
+               restore: Callable[[Any], None] | None = None) -> LoadPath:
     """Apply the load in increments of the load factor from 0 up to 1.
 
     ``assemble(U, factor)`` returns (F_ext, F_int, K) at the trial state (a ProblemError there, e.g.
@@ -103,6 +124,8 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
     ``anderson = m > 0`` mixes each Newton step with the last m (Anderson acceleration of the
     fixed-point map U -> U + K^-1 r(U), restarted whenever ``assemble`` returns a new K): perfect
     plasticity needs it, see :class:`Anderson`.
+
+    ``judge``, ``recheck``, ``snapshot`` and ``restore``: the response criterion of a limit load (module doc).
     """
     steps, tolerance = loading.steps, loading.tolerance
     path = LoadPath(U=np.zeros(n_dofs) if U0 is None else U0.copy())
@@ -110,45 +133,51 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
     factor, dfactor = 0.0, 1.0 / steps
     last_step, last_dfactor = None, 0.0
     report, converged_increments = progress.current(), 0
+    min_step = 1.0 / steps / 2 ** loading.max_cutbacks
+    max_step, before = 1.0 / steps, None
+
+    def exhausted() -> bool:
+        if judge is None:
+            return path.cutbacks >= loading.max_cutbacks
+        return dfactor <= min_step * (1 + 1e-9)
+
+    def newton(target: float, cap: int) -> tuple[np.ndarray, bool, int]:
+        start = path.U.copy()
+        if last_step is not None:
+            start += (target - factor) / last_dfactor * last_step
+        start[fixed] = start_values + target * (fixed_values - start_values)
+        status = lambda it, r: report.status(_iteration_status(   # noqa: E731
+            converged_increments, factor, dfactor, target, it, r, path.cutbacks))
+        return _newton(path, start, target, cap, fixed, tolerance, assemble, solve, anderson, status)
+
     while factor < 1.0 - 1e-12:
         target = min(1.0, factor + dfactor)
-        trial, converged, it = path.U.copy(), False, 0
-        if last_step is not None:
-            trial += (target - factor) / last_dfactor * last_step
-        trial[fixed] = start_values + target * (fixed_values - start_values)
-        ref = None
-        mixer = Anderson(anderson)
-        for it in range(1, loading.max_iterations + 1):
-            try:
-                f_ext, f_int, K = assemble(trial, target)
-            except ProblemError:
-                break
-            if ref is None:
-                ref = max(np.linalg.norm(f_ext), 1e-30)
-            residual = f_ext - f_int
-            scale = max(ref, np.linalg.norm(f_int))   # reactions carry a displacement-driven load
-            residual[fixed] = 0.0
-            report.status(_iteration_status(converged_increments, factor, dfactor, target, it,
-                                            float(np.linalg.norm(residual)) / scale, path.cutbacks))
-            du = solve(K, residual)
-            if not np.all(np.isfinite(du)):
-                raise ProblemError("the tangent stiffness is singular: the constraints do not stop every "
-                                   "rigid-body motion", key="constraint")
-            step = mixer.step(trial, du, K)
-            trial += step
-            path.newton_iterations += 1
-            if it == 1:
-                first_step = np.linalg.norm(du)
-            elif np.linalg.norm(du) > DIVERGENCE * max(first_step, np.linalg.norm(path.U)):
-                break                    # a mechanism: Newton runs away; cut back without more iterations
-            if (np.linalg.norm(residual) <= tolerance * scale
-                    and np.linalg.norm(du) <= tolerance * max(np.linalg.norm(trial), 1e-30)):
-                converged = True
-                break
-        if not converged:
-            if path.cutbacks >= loading.max_cutbacks:
-                path.history.append({"load_factor": target, "converged": False, "iterations": it,
-                                     "note": f"no convergence after {loading.max_cutbacks} cut-backs"})
+        trial, converged, it = newton(target, loading.max_iterations)
+        verdict, note, judged = None, "", {}
+        if not converged and recheck and exhausted():
+            trial, converged, it = newton(target, 2 * loading.max_iterations)   # a symptom: check with twice the cap
+            note = (f"converged only with twice max_iterations ({it})" if converged else
+                    f"no convergence with twice max_iterations ({2 * loading.max_iterations}) either")
+        if converged and judge is not None:
+            verdict, judged = judge(factor, path.U, target, trial)
+        if not converged or verdict is not None:
+            reason = verdict if verdict is not None else f"no convergence after {loading.max_cutbacks} cut-backs"
+            if exhausted() and before is not None and factor - before[0] > ROLLBACK * min_step * (1 + 1e-9):
+                # the carried level was reached by a long step: go back and take that step again in halves
+                a, U_a, state_a, last_step, last_dfactor, entry = before
+                path.history.append({"load_factor": target, "converged": False, "equilibrium": converged,
+                                     "iterations": it, "note": f"{reason}; the level below was reached by a step "
+                                     f"of {factor - a:.4g}: taken again in halves from {a:.6g}", **judged})
+                path.history[entry].update(converged=False, note="not carried: its step was too long to read "
+                                           "the curve at it; taken again in halves")
+                restore(state_a)
+                max_step = dfactor = 0.5 * (factor - a)
+                path.U, factor, before = U_a, a, None
+                converged_increments -= 1
+                continue
+            if exhausted():
+                path.history.append({"load_factor": target, "converged": False, "equilibrium": converged,
+                                     "iterations": it, "note": "; ".join(n for n in (reason, note) if n), **judged})
                 report.status("")
                 if stop_on_failure:
                     path.failed_at, path.failed_trial = target, trial
@@ -158,18 +187,56 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
                                        history=path.history)
             path.cutbacks += 1
             dfactor *= 0.5
-            path.history.append({"load_factor": target, "converged": False, "iterations": it,
-                                 "note": f"increment cut back to {dfactor:.4g}"})
+            path.history.append({"load_factor": target, "converged": False, "equilibrium": converged,
+                                 "iterations": it, "note": (f"{verdict}: " if verdict is not None else "")
+                                 + f"increment cut back to {dfactor:.4g}", **judged})
             continue
+        if judge is not None and snapshot is not None:   # where the path may come back to (see ROLLBACK)
+            before = (factor, path.U, snapshot(), last_step, last_dfactor, len(path.history))
         last_step, last_dfactor = trial - path.U, target - factor
         path.U, factor = trial, target
         if it <= loading.max_iterations // 2:   # an easy increment: let a cut-back step grow back
-            dfactor = min(2.0 * dfactor, 1.0 / steps)
+            dfactor = min(2.0 * dfactor, max_step)
         path.history.append({"load_factor": factor, "converged": True, "iterations": it,
-                             **on_converged(factor, path.U)})
+                             **({"note": note} if note else {}), **judged, **on_converged(factor, path.U)})
         converged_increments += 1
     report.status("")
     return path
+
+
+def _newton(path: LoadPath, trial: np.ndarray, target: float, cap: int, fixed: np.ndarray, tolerance: float,
+            assemble: Callable, solve: Callable, anderson: int, status: Callable[[int, float], None]
+            ) -> tuple[np.ndarray, bool, int]:
+    """Newton's iterations (at most ``cap``) of one increment to load factor ``target`` from the predictor
+    ``trial`` (n_dofs,); (the last iterate, converged, the iterations taken). Counts into ``path``."""
+    converged, it, ref = False, 0, None
+    mixer = Anderson(anderson)
+    for it in range(1, cap + 1):
+        try:
+            f_ext, f_int, K = assemble(trial, target)
+        except ProblemError:
+            break
+        if ref is None:
+            ref = max(np.linalg.norm(f_ext), 1e-30)
+        residual = f_ext - f_int
+        scale = max(ref, np.linalg.norm(f_int))   # reactions carry a displacement-driven load
+        residual[fixed] = 0.0
+        status(it, float(np.linalg.norm(residual)) / scale)
+        du = solve(K, residual)
+        if not np.all(np.isfinite(du)):
+            raise ProblemError("the tangent stiffness is singular: the constraints do not stop every "
+                               "rigid-body motion", key="constraint")
+        trial = trial + mixer.step(trial, du, K)
+        path.newton_iterations += 1
+        if it == 1:
+            first_step = np.linalg.norm(du)
+        elif np.linalg.norm(du) > DIVERGENCE * max(first_step, np.linalg.norm(path.U)):
+            break                    # a mechanism: Newton runs away; cut back without more iterations
+        if (np.linalg.norm(residual) <= tolerance * scale
+                and np.linalg.norm(du) <= tolerance * max(np.linalg.norm(trial), 1e-30)):
+            converged = True
+            break
+    return trial, converged, it
 
 
 def _iteration_status(done: int, factor: float, dfactor: float, target: float, iteration: int, residual: float,

@@ -41,6 +41,7 @@ from ctmrpim.materials.mohr_coulomb import ELASTIC, MohrCoulomb, equivalent_plas
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.settings import Loading
 from ctmrpim.result import Result
+from ctmrpim.solvers.limit_criteria import SettlementCriterion, limit_load
 from ctmrpim.solvers.load_stepping import LoadPath, step_loads
 from ctmrpim.solvers.weak_form import internal_force, tangent
 from ctmrpim.timing import Timer
@@ -269,10 +270,13 @@ class PlasticSystem:
 
     def run(self, loading: Loading, material_at: Callable[[float], MohrCoulomb],
             load_at: Callable[[float], float], on_converged: Callable[[float, np.ndarray], dict[str, Any]],
-            fixed_values: np.ndarray | None = None, stop_on_failure: bool = False) -> LoadPath:
+            fixed_values: np.ndarray | None = None, stop_on_failure: bool = False,
+            judge: Callable[[float, np.ndarray, float, np.ndarray], tuple[str | None, dict]] | None = None,
+            recheck: bool = False) -> LoadPath:
         """Step a path parameter t from 0 to 1 from the committed state: the material is
         ``material_at(t)`` and the loads are at ``load_at(t)`` times their full value (a load ramp,
-        or a strength-reduction stage at constant load)."""
+        or a strength-reduction stage at constant load); ``judge`` and ``recheck`` as in
+        :func:`~ctmrpim.solvers.load_stepping.step_loads`."""
         if self.tangent != "elastic":
             self._K = None
 
@@ -285,18 +289,21 @@ class PlasticSystem:
 
         return step_loads(len(self.U), loading, self.fixed,
                           self.fixed_values if fixed_values is None else fixed_values, assemble, self.solve,
-                          converged, U0=self.U, stop_on_failure=stop_on_failure, anderson=ANDERSON)
+                          converged, U0=self.U, stop_on_failure=stop_on_failure, anderson=ANDERSON,
+                          judge=judge, recheck=recheck, snapshot=self.snapshot, restore=self.restore)
 
-
-def limit_load(path: LoadPath, peak_traction: float) -> dict[str, Any]:
-    """The limit load of a run ``until_failure``: the last load factor carried and the one that was not
-    (None if the full load was carried), and the same as the peak traction on the loaded boundary (the
-    limit pressure of a uniformly loaded footing)."""
-    carried = max((h["load_factor"] for h in path.history if h["converged"]), default=0.0)
-    failed = path.failed_at
-    return {"limit_load_factor": {"carried": carried, "failed": failed},
-            "limit_pressure": {"carried": carried * peak_traction,
-                               "failed": None if failed is None else failed * peak_traction}}
+    def elastic_response(self, F: np.ndarray) -> np.ndarray:
+        """U (2n,) of the elastic stiffness under the forces F (2n,), zero at the fixed dofs."""
+        K = self.elastic_stiffness()
+        if self._lu_elastic is None:
+            try:
+                self._lu_elastic = self._factorise(K)
+            except RuntimeError as exc:
+                raise self._unconstrained(exc) from None
+            self.factorisations += 1
+        U = np.zeros_like(F)
+        U[self.free] = self._lu_elastic.solve(F[self.free])
+        return U
 
 
 @dataclass
@@ -351,8 +358,11 @@ def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, tim
         return solve_strength_reduction(case, system, out, base, progress)
     if case.problem.analysis == "dynamic":
         return _relaxed(case, system, out, timer)
+    criterion = (SettlementCriterion.build(system, case.loading.limit_slope)
+                 if case.loading.until_failure and case.loading.limit_slope > 0 else None)
     path = system.run(case.loading, lambda t: material, lambda t: t, on_converged,
-                      stop_on_failure=case.loading.until_failure)
+                      stop_on_failure=case.loading.until_failure, judge=criterion,
+                      recheck=case.loading.until_failure)
     timer.lap("solve")
     probes = out.probe_values(path.U, system.stress[:, :3])
     stress = out.nodal_stress(system.stress)
@@ -364,7 +374,7 @@ def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, tim
     return Result(
         method=out.method, points=out.points, u=out.displacement(path.U), **stress, cells=out.cells,
         probes=probes, errors={}, counts=counts, timings=timer.total(), history=path.history, series=series,
-        outcome=limit_load(path, out.peak_traction) if case.loading.until_failure else {},
+        outcome=limit_load(path, out.peak_traction, criterion) if case.loading.until_failure else {},
         fields=fields, parameters=out.parameters, defaults=case.defaults)
 
 

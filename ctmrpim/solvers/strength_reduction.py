@@ -46,9 +46,13 @@ from ctmrpim.result import Result
 from ctmrpim.solvers.dynamic_relaxation import max_displacement, relax
 from ctmrpim.timing import Timer
 
-CRITERION = {"newton": "non-convergence: the equilibrium iteration (loading.tangent: Newton, or the elastic "
-                       "stiffness with Anderson mixing) did not reach the residual and displacement tolerance within "
-                       "loading.max_iterations iterations at an SRF sub-step cut back loading.max_cutbacks times",
+CRITERION = {"newton": "displacement runaway or non-convergence: a level is failed when the largest nodal displacement "
+                       "from the last stable level, per unit relative rise of the SRF, exceeds "
+                       "strength-reduction.limit_growth times the largest displacement at SRF = start (the response: "
+                       "the SRF-displacement curve turning flat), or when the equilibrium iteration (loading.tangent: "
+                       "Newton, or the elastic stiffness with Anderson mixing) does not reach the residual and "
+                       "displacement tolerance at an SRF sub-step cut back loading.max_cutbacks times, re-checked with "
+                       "twice loading.max_iterations before it counts",
              "dynamic-relaxation": "still moving: after dynamic.steps steps of dynamic relaxation the out-of-balance "
                                    "force is above dynamic.tolerance of the loads and the maximum displacement grew "
                                    "by more than 1 % over the last quarter of the steps (the paper's criterion: it "
@@ -78,6 +82,8 @@ class Level:
     state: tuple[np.ndarray, ...]    # (U, stress, region, plastic strain): converged, or a failed level's last iterate
     criterion: str = ""              # a failed level: why; a stable one: how it was reached, where not its own
     path: list[list[float]] | None = None          # dynamic relaxation: [step, max displacement] as it ran
+    growth: float | None = None      # the search: displacement from the stable level below per relative SRF rise,
+                                     # in units of the displacement at SRF = start (the runaway measure)
 
     @property
     def max_displacement(self) -> float:
@@ -90,6 +96,7 @@ class Level:
         return {"srf": self.srf, "stable": self.stable, "iterations": self.iterations, "cutbacks": self.cutbacks,
                 "max_displacement": self.max_displacement, "seconds": round(self.seconds, 3),
                 **({"criterion": self.criterion} if self.criterion else {}),
+                **({"growth": self.growth} if self.growth is not None else {}),
                 **({"displacement_history": self.path} if self.path is not None else {})}
 
 
@@ -109,15 +116,15 @@ def _relax_level(system, relaxation: Relaxation, material: MohrCoulomb, srf: flo
                  f"not at rest, still moving ({100 * growth:.2g} % over the last quarter)", history)
 
 
-def _level(system, loading, material_at, load_at, srf_at: Callable[[float], float], fixed_values=None
-           ) -> tuple[Level, Level | None]:
+def _level(system, loading, material_at, load_at, srf_at: Callable[[float], float], fixed_values=None,
+           recheck: bool = True) -> tuple[Level, Level | None]:
     """Run the path t = 0..1 from the committed state; returns the level at t = 1 (stable, or failed
     at the sub-step that did not converge) and, for a failed level whose cut-back sub-steps got part of
     the way, the stable level reached (the system is left there)."""
     timer = Timer()
     with _progress.current().stage(f"SRF {srf_at(1.0):.4f}"):   # Newton's increments, labelled with the level
         path = system.run(loading, material_at, load_at, lambda t, U: {}, fixed_values=fixed_values,
-                          stop_on_failure=True)
+                          stop_on_failure=True, recheck=recheck)
     seconds = timer.elapsed()
     if path.failed_at is None:
         return Level(srf_at(1.0), True, path.newton_iterations, path.cutbacks, seconds, system.snapshot()), None
@@ -138,7 +145,7 @@ def gravity_level(system, loading: Loading, material: MohrCoulomb, srf: float,
     m = reduced(material, srf)
     if relaxation is not None:
         return _relax_level(system, relaxation, m, srf)
-    return _level(system, loading, lambda t: m, lambda t: t, lambda t: srf)[0]
+    return _level(system, loading, lambda t: m, lambda t: t, lambda t: srf, recheck=False)[0]
 
 
 def search(system, loading: Loading, material: MohrCoulomb, settings: StrengthReduction,
@@ -154,6 +161,7 @@ def search(system, loading: Loading, material: MohrCoulomb, settings: StrengthRe
         raise ProblemError(f"the body fails under its loads already at SRF = {settings.start:g} (the gravity "
                            "stage does not converge); lower strength-reduction.start", key="strength-reduction.start")
     stable, failed = first, None
+    reference = max(first.max_displacement, 1e-300)
     fixed_values = system.U[system.fixed].copy()
     level_loading = replace(loading, steps=settings.steps)
     while failed is None or failed.srf - stable.srf > settings.width * (1 + 1e-9):
@@ -170,9 +178,16 @@ def search(system, loading: Loading, material: MohrCoulomb, settings: StrengthRe
             level, reached = _level(system, level_loading, lambda t: reduced(material, srf_at(t)), lambda t: 1.0,
                                     srf_at, fixed_values)
         if reached is not None:   # the cut-back sub-steps converged part of the way: stable there
+            _judge(stable, reached, reference, settings.limit_growth)
             progress(reached)
             levels.append(reached)
-            stable = reached
+            if reached.stable:
+                stable = reached
+            else:                 # it ran away already: the level beyond is failed at least as much
+                failed = reached
+                continue
+        if level.stable:
+            _judge(stable, level, reference, settings.limit_growth)
         progress(level)
         levels.append(level)
         if level.stable:
@@ -181,6 +196,20 @@ def search(system, loading: Loading, material: MohrCoulomb, settings: StrengthRe
             failed = level
     system.restore(stable.state)
     return levels, stable, failed
+
+
+def _judge(stable: Level, level: Level, reference: float, limit: float) -> None:
+    """Mark ``level``, in equilibrium, failed where the displacement ran away from ``stable``: the largest nodal
+    displacement between them per relative SRF rise, in units of ``reference`` (the largest displacement at
+    SRF = start), above ``limit`` (0: no response criterion)."""
+    rise = (level.srf - stable.srf) / stable.srf
+    if rise <= 0:
+        return
+    level.growth = max_displacement(level.state[0] - stable.state[0]) / rise / reference
+    if limit > 0 and level.growth > limit:
+        level.stable = False
+        level.criterion = (f"displacement runaway ({level.growth:.3g} x the displacement at SRF = start per unit "
+                           f"relative SRF rise, above {limit:g}; in equilibrium)")
 
 
 def sweep(system, loading: Loading, material: MohrCoulomb, values: tuple[float, ...],
@@ -237,8 +266,15 @@ def solve_strength_reduction(case: Case, system, out, base: Result,
         base.fields = out.plastic_field(plastic)
     base.history = [lv.record() for lv in levels]
     base.series = series
+    decisive = next((lv for lv in levels if not lv.stable and lv.srf == failed), None)
+    ordered = sorted(levels, key=lambda lv: lv.srf)
     base.outcome = {"factor_of_safety": {"stable": stable, "failed": failed, "criterion": CRITERION[settings.solver],
-                                         "mode": "sweep" if settings.values else "search"}}
+                                         "mode": "sweep" if settings.values else "search",
+                                         "decided_by": None if decisive is None else decisive.criterion.split(" (")[0],
+                                         "limit_growth": settings.limit_growth if settings.solver == "newton" else None},
+                    "srf_displacement": {"srf": [lv.srf for lv in ordered],
+                                         "max_displacement": [lv.max_displacement for lv in ordered],
+                                         "stable": [lv.stable for lv in ordered]}}
     base.counts.update(levels=len(levels), newton_iterations=sum(lv.iterations for lv in levels),
                        cutbacks=sum(lv.cutbacks for lv in levels), **system.iteration_counts())
     base.timings = {**base.timings, "strength_reduction": seconds,

@@ -34,9 +34,10 @@ def test_prandtl_reissner_factors() -> None:
 
 
 def test_safeguarded_solve_of_a_frictional_footing() -> None:
-    """FE P2 on the coarse phi = 20 deg footing: apex returns make the consistent tangent exactly singular in
-    some iterations (before: exit 2); those steps take the elastic stiffness and the run finds the limit."""
-    case = benchmarks.load("footing-phi20", COARSE)
+    """FE P2 on the coarse phi = 20 deg footing loaded along its plateau (``limit_slope = 0``: non-convergence
+    alone ends the run, as before issue 19's item 2): apex returns make the consistent tangent exactly singular
+    in some iterations (before: exit 2); those steps take the elastic stiffness and the run finds the limit."""
+    case = benchmarks.load("footing-phi20", COARSE + ["loading.limit_slope=0"])
     r = solve(case, "fem", "p2")
     assert r.counts["safeguarded_steps"] > 0
     limit = r.outcome["limit_pressure"]
@@ -46,6 +47,39 @@ def test_safeguarded_solve_of_a_frictional_footing() -> None:
     carried = [h for h in r.history if h["converged"]]
     w = -np.array([h["centre"]["uy"] for h in carried])
     assert np.all(np.diff(w) > 0)
+
+
+def test_the_limit_is_read_from_the_load_settlement_curve() -> None:
+    """The response criterion (issue 19, item 2) on the coarse phi = 20 deg footing by FE P2: the last carried
+    increment still rises at least limit_slope = 1 % of the elastic slope, the first one not carried is in
+    equilibrium but below it (Newton converges on the plateau: that is not "carried"), and summary.json states the
+    criterion and the curve."""
+    r = solve(benchmarks.load("footing-phi20", COARSE), "fem", "p2")
+    limit, criterion, curve = (r.outcome[k] for k in ("limit_pressure", "limit_criterion", "load_settlement"))
+    assert criterion["decided_by"] == "settlement runaway" and criterion["limit_slope"] == 0.01
+    assert criterion["slope_ratio_at_carried"] >= 0.01 > criterion["slope_ratio_at_failed"]
+    q_u = prandtl_reissner(1e4, 20.0)
+    check("footing-phi20-coarse-fem-p2-criterion-limit",
+          max(abs(limit["carried"] / q_u - 1), abs(limit["failed"] / q_u - 1)))
+    carried = np.array(curve["carried"])
+    q, w = np.array(curve["pressure"]), np.array(curve["settlement"])
+    assert q[carried].max() == pytest.approx(limit["carried"]) and not carried[-1] and q[-1] == limit["failed"]
+    assert np.all(np.diff(w[carried]) > 0) and np.all(np.diff(q[carried]) > 0)
+    # the elastic slope: the first increment (21 kPa, a few plastic points at the footing's edge) is nearly elastic
+    assert q[0] / w[0] == pytest.approx(criterion["elastic_slope"], rel=0.1)
+
+
+@pytest.mark.slow
+def test_the_coarse_limit_depends_on_neither_the_tangent_nor_the_cap() -> None:
+    """The same footing by both methods with the elastic-stiffness iteration (max_iterations = 100) and with
+    Newton's cap doubled (30): the limit moves by less than the issue's 1 % and 0.5 % (about a minute)."""
+    for solver, element in (("fem", "p2"), ("ctm-rpim", None)):
+        base, elastic, doubled = (
+            solve(benchmarks.load("footing-phi20", COARSE + extra), solver, element).outcome["limit_pressure"]
+            for extra in ([], ["loading.tangent=\"elastic\"", "loading.max_iterations=100"],
+                          ["loading.max_iterations=30"]))
+        check("footing-limit-tangent-change", max(abs(elastic[k] / base[k] - 1) for k in ("carried", "failed")))
+        check("footing-limit-cap-change", max(abs(doubled[k] / base[k] - 1) for k in ("carried", "failed")))
 
 
 def test_a_solve_that_gives_up_exits_3(tmp_path, capsys) -> None:

@@ -12,6 +12,8 @@ from ctmrpim import benchmarks
 from ctmrpim.methods import solve
 
 BISHOP = {"slope": 1.368, "slope-gl": 1.378}
+#: what fails a level of the Newton search: the SRF-displacement curve's runaway, or non-convergence re-checked
+FAILED = ("displacement runaway", "non-convergence")
 
 
 @pytest.mark.slow
@@ -29,7 +31,7 @@ def test_factor_of_safety_bracket_against_bishop(name: str, solver: str, tag: st
     levels = r.history
     assert levels[0]["srf"] == 1.0 and levels[0]["stable"]
     assert all(h["stable"] for h in levels if h["srf"] <= stable)
-    assert all(not h["stable"] and h["criterion"] == "non-convergence" for h in levels if h["srf"] >= failed)
+    assert all(not h["stable"] and h["criterion"].startswith(FAILED) for h in levels if h["srf"] >= failed)
     # as the paper's Fig. 20: isolated plastic zones at SRF = 1, a band from the toe up through the slope at failure
     problem = benchmarks.load(name).problem
     assert r.series[0]["time"] == 1.0 and r.series[-1]["time"] == failed
@@ -71,8 +73,48 @@ def test_search_brackets_the_factor_of_safety_on_a_coarse_cloud(solver: str, ele
     levels = r.history
     assert levels[0]["srf"] == 1.0 and levels[0]["stable"]
     assert all(h["stable"] for h in levels if h["srf"] <= stable)
-    assert all(not h["stable"] and h["criterion"] == "non-convergence" for h in levels if h["srf"] >= failed)
+    assert all(not h["stable"] and h["criterion"].startswith(FAILED) for h in levels if h["srf"] >= failed)
     assert r.series[0]["time"] == 1.0 and r.series[-1]["time"] == failed
+    # summary.json's curve: every level by SRF, its largest displacement and verdict
+    curve = r.outcome["srf_displacement"]
+    assert curve["srf"] == sorted(h["srf"] for h in levels) and curve["stable"][0]
+    assert fos["decided_by"] in FAILED and fos["limit_growth"] == 100.0
+
+
+def test_a_level_whose_displacement_runs_away_has_failed() -> None:
+    """The response criterion on its own: a level in equilibrium whose largest displacement from the stable level
+    below, per unit relative SRF rise, exceeds limit_growth times the displacement at SRF = start has failed."""
+    from ctmrpim.solvers.strength_reduction import Level, _judge
+    def level(srf: float, uy: float) -> Level:
+        U = np.zeros(4)
+        U[1] = uy
+        return Level(srf, True, 1, 0, 0.0, (U, None, None, None))
+    stable = level(1.5, -0.05)
+    creeping, running = level(1.515, -0.06), level(1.515, -0.2)
+    _judge(stable, creeping, 0.03, 100.0)                   # 0.01 m per 1 % rise: 33 x 0.03 m
+    _judge(stable, running, 0.03, 100.0)                    # 0.15 m per 1 % rise: 500 x 0.03 m
+    assert creeping.stable and creeping.growth == pytest.approx(0.01 / 0.01 / 0.03)
+    assert not running.stable and running.criterion.startswith("displacement runaway")
+    off = level(1.515, -0.2)
+    _judge(stable, off, 0.03, 0.0)                          # limit_growth = 0: non-convergence alone decides
+    assert off.stable and off.growth == pytest.approx(500.0)
+
+
+@pytest.mark.slow
+def test_newton_on_the_plateau_is_not_stable() -> None:
+    """Newton on the consistent tangent converges far along the plateau (before item 2 of issue 19: the vertical
+    cut "stable" at SRF 1.70 with 145 m of displacement, CTM-RPIM); with the runaway criterion its factor of safety
+    on a coarse vertical cut is the elastic-stiffness iteration's (about a minute)."""
+    fs = {}
+    for tangent in ("consistent", "elastic"):
+        extra = ["parameters.h=1.0", f"loading.tangent=\"{tangent}\""]
+        r = solve(benchmarks.load("vertical-cut", extra + (["loading.max_iterations=15"] if tangent == "consistent"
+                                                          else [])))
+        fs[tangent] = r.outcome["factor_of_safety"]
+        assert all(h.get("growth", 0.0) <= 100.0 for h in r.history if h["stable"])
+    assert fs["consistent"]["decided_by"] == "displacement runaway"
+    check("vertical-cut-fs-tangent-change",
+          max(abs(fs["consistent"][k] / fs["elastic"][k] - 1) for k in ("stable", "failed")))
 
 
 def test_sweep_mode_brackets_from_independent_levels() -> None:
