@@ -4,7 +4,7 @@ Degrees of freedom are interleaved: node i owns dofs 2i (u_x) and 2i+1 (u_y). Th
 K = sum_p w_p B~_p^T D B_p (the paper's Eq. 7 lacks the transpose on B; Eq. 9's form is used), summed
 node row by node row straight into K's CSR arrays by the compiled kernels of
 :mod:`ctmrpim.discretisation.stiffness_kernels`, never by scattering a dense block per integration point;
-small systems in a process where numba has not run yet are assembled by scipy's sparse products instead.
+small systems are assembled by scipy's sparse products instead (the two agree to round-off).
 """
 from __future__ import annotations
 
@@ -19,8 +19,8 @@ from ctmrpim.problem.model import Problem
 
 THREADS = 2            # blocks of node rows assembled concurrently
 ROW_BLOCK = 512        # node rows per kernel call on the thread pool
-#: below this many shape-function entries scipy's products are taken, unless numba already runs in the
-#: process (its first kernel call costs 0.2-0.45 s; :data:`ctmrpim.discretisation.rpim.COMPILED_MIN_POINTS`)
+#: below this many shape-function entries scipy's products are taken (numba's first kernel call in a
+#: process costs 0.2-0.45 s; :data:`ctmrpim.discretisation.rpim.COMPILED_MIN_POINTS`)
 COMPILED_MIN_ENTRIES = 300_000
 
 
@@ -61,12 +61,16 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     itype = np.int32 if max(nnz, 2 * n) < 2**31 - 1 else np.int64
     k_indices = np.empty(nnz, itype)
     k_data = np.empty(nnz)
-    _run(lambda ab: kernels.stiffness_rows(indptr, indices, *data, w, Dc, tptr, trow, tent, n, node_start, *ab,
-                                           k_indices, k_data), blocks)
     k_indptr = np.empty(2 * n + 1, itype)
     k_indptr[0:-1:2] = 4 * node_start[:-1]
     k_indptr[1::2] = 4 * node_start[:-1] + 2 * counts
     k_indptr[-1] = nnz
+    # symmetric K (Galerkin, symmetric D) on sorted rows: the upper blocks summed, the lower ones copied
+    upper = test is None and np.array_equal(D, D.T) and dNdx.has_canonical_format
+    _run(lambda ab: kernels.stiffness_rows(indptr, indices, *data, w, Dc, tptr, trow, tent, n, node_start, *ab,
+                                           k_indices, k_data, upper), blocks)
+    if upper:
+        _run(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks)
     K = sp.csr_matrix((k_data, k_indices, k_indptr), shape=(2 * n, 2 * n), copy=False)
     K.has_sorted_indices = True
     K.has_canonical_format = True

@@ -33,8 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.sparse as sp
 
-from ctmrpim.discretisation import rpim_kernels, vci_kernels
-from ctmrpim.discretisation.assembly import COMPILED_MIN_ENTRIES
+from ctmrpim.discretisation import assembly, rpim_kernels, vci_kernels
 from ctmrpim.discretisation.ctm import BoundaryQuadrature, boundary_points
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator, value_operator
 from ctmrpim.discretisation.rpim import ShapeFunctions
@@ -66,7 +65,7 @@ def corrected_gradients(nodes: np.ndarray, d_c: float, points: np.ndarray, w: np
     against the ``boundary`` Gauss points, where ``N_boundary`` (b, n) are the shape functions. ``nodes``
     (n, 2), ``d_c`` the node spacing (it scales q). A node in no point's support keeps its gradients."""
     dx, dy, N = sf.dNdx, sf.dNdy, sf.N
-    if not rpim_kernels.use_compiled(dx.nnz, COMPILED_MIN_ENTRIES):
+    if not rpim_kernels.use_compiled(dx.nnz, assembly.COMPILED_MIN_ENTRIES):
         return _numpy_corrected_gradients(nodes, d_c, points, w, sf, boundary, N_boundary, order)
     n = len(nodes)
     quadratic = order != "linear"

@@ -12,8 +12,8 @@ shape functions do not change under this, and the conditioning is far better.
 The loops over the points are compiled (:mod:`ctmrpim.discretisation.rpim_kernels`): a count pass over
 a cell grid of the nodes sizes the CSR rows, then blocks of points, on a thread pool, each solve their
 systems one point at a time into those rows. Memory is the result plus one system per thread. Small
-sets of points in a process where numba has not run yet take a numpy path instead (numba's start-up
-would cost more than it saves): padded supports solved in batches by LAPACK, chunk by chunk.
+sets of points take a numpy path instead (numba's start-up would cost more than it saves): padded
+supports solved in batches by LAPACK, chunk by chunk. The two agree to round-off.
 
 The result is stored as sparse rows (point -> support nodes, in increasing node order), ready for
 B^T D B products.
@@ -34,9 +34,9 @@ from ctmrpim.errors import ProblemError
 BLOCK = 2048                 # points per kernel call on the thread pool
 THREADS = 2                  # blocks (compiled) or chunks (numpy) solved concurrently
 CHUNK = 128                  # numpy path: points per batched solve, (CHUNK, k+m, k+m) stays in cache
-#: below this many points the numpy path is taken, unless numba is already initialised in the process:
-#: numba's first kernel call costs about 0.2-0.45 s (its lowering registries load, cached kernels or not),
-#: and the compiled path saves about 10-50 us per point (measured on this project's two-core machine)
+#: below this many points the numpy path is taken: numba's first kernel call in a process costs about
+#: 0.2-0.45 s (its lowering registries load, cached kernels or not), and the compiled path saves about
+#: 10-50 us per point (measured on this project's two-core machine)
 COMPILED_MIN_POINTS = 8000
 PARTITION_OF_UNITY_TOL = 1e-6  # sum_i phi_i - 1 beyond this means the moment matrix was numerically singular
 

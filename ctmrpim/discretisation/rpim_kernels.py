@@ -34,7 +34,8 @@ OK, SINGULAR, NOT_UNITY = 0, 1, 2
 def numba_ready() -> bool:
     """Whether numba's compiler is already initialised in this process (a compiled kernel has run): its first
     kernel call, cached or not, loads numba's lowering registries (0.2-0.45 s measured here), later ones
-    cost microseconds."""
+    cost microseconds. Only kernels whose results are bit for bit those of their numpy forms (copies,
+    exact sums) are chosen by it."""
     # numba creates its target context when a kernel is decorated (at import); the costly part is the
     # registries and runtime it loads on the first call, which initialises the runtime (NRT)
     from numba.core.runtime.nrt import rtsys
@@ -43,8 +44,10 @@ def numba_ready() -> bool:
 
 
 def use_compiled(work: int, threshold: int) -> bool:
-    """Take the compiled path for ``work`` items: at or above ``threshold``, or once numba runs anyway."""
-    return work >= threshold or numba_ready()
+    """Take the compiled path for ``work`` items: at or above ``threshold``. The choice depends on the size
+    alone, never on whether numba already runs in the process: the two paths differ by round-off, and a
+    resumed explicit run must repeat the uninterrupted one bit for bit."""
+    return work >= threshold
 
 
 def cell_grid(nodes: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, int, int]:

@@ -63,11 +63,13 @@ def row_counts(indptr, indices, tptr, trow, n, r0, r1, counts):
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
 def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n, node_start, r0, r1,
-                   k_indices, k_data):
+                   k_indices, k_data, upper):
     """Rows 2I and 2I + 1 of K for r0 <= I < r1 into the interleaved CSR arrays: node row I owns
     4 node_start[I] .. 4 node_start[I + 1] (its c neighbours: row 2I first, 2c entries, then row 2I + 1),
     columns 2J, 2J + 1 for J ascending. (dx, dy) the trial and (tdx, tdy) the test gradients on the pattern
-    (indptr, indices), w the points' weights, D (3, 3)."""
+    (indptr, indices), w the points' weights, D (3, 3). ``upper``: K symmetric (B~ = B, D symmetric) and the
+    pattern's rows sorted: only the blocks J >= I are summed and written (the entries after I's in a point's
+    row are those), half the work; :func:`mirror_lower` writes the rest."""
     mark = np.full(n, -1, np.int64)
     pos = np.empty(n, np.int64)
     width = 0
@@ -103,7 +105,7 @@ def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n,
             e = tent[t]
             ax = tdx[e] * w[p]
             ay = tdy[e] * w[p]
-            for k in range(indptr[p], indptr[p + 1]):
+            for k in range(e if upper else indptr[p], indptr[p + 1]):
                 q = pos[indices[k]]
                 bx = dx[k]
                 by = dy[k]
@@ -115,6 +117,12 @@ def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n,
         o1 = o0 + 2 * c
         for q in range(c):
             j = cs[q]
+            if upper and j < i:
+                k_indices[o0 + 2 * q] = 2 * j
+                k_indices[o0 + 2 * q + 1] = 2 * j + 1
+                k_indices[o1 + 2 * q] = 2 * j
+                k_indices[o1 + 2 * q + 1] = 2 * j + 1
+                continue
             a, b, g, h = xx[q], xy[q], yx[q], yy[q]
             # B~_I^T D B_J with B = [[d/dx, 0], [0, d/dy], [d/dy, d/dx]]
             k_indices[o0 + 2 * q] = 2 * j
@@ -207,3 +215,26 @@ def fill_lower_band(indptr, indices, data, rank, ab):
             pc = rank[indices[k]]
             if pr >= pc:
                 ab[pr - pc, pc] = data[k]
+
+
+@njit(cache=True, nogil=True)
+def mirror_lower(k_indptr, k_indices, k_data, r0, r1):
+    """K[2J:2J+2, 2I:2I+2] = K[2I:2I+2, 2J:2J+2]^T for the node rows r0 <= J < r1 and every I < J (the blocks
+    :func:`stiffness_rows` left with ``upper``); columns sorted within rows."""
+    for jn in range(r0, r1):
+        a0 = k_indptr[2 * jn]
+        a1 = k_indptr[2 * jn + 1]
+        for t in range(a0, a1, 2):
+            col = k_indices[t]
+            inode = col // 2
+            if inode >= jn:
+                break
+            # the position of column 2J in row 2I (binary search; columns sorted)
+            s0 = k_indptr[2 * inode]
+            s1 = k_indptr[2 * inode + 1]
+            u = s0 + np.searchsorted(k_indices[s0:s1], 2 * jn)
+            v = s1 + (u - s0)                      # the same column in row 2I + 1
+            k_data[t] = k_data[u]                  # K[2J, 2I] = K[2I, 2J]
+            k_data[t + 1] = k_data[v]              # K[2J, 2I + 1] = K[2I + 1, 2J]
+            k_data[a1 + (t - a0)] = k_data[u + 1]  # K[2J + 1, 2I] = K[2I, 2J + 1]
+            k_data[a1 + (t - a0) + 1] = k_data[v + 1]

@@ -28,7 +28,7 @@ import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 from threadpoolctl import threadpool_limits
 
-from ctmrpim.discretisation import rpim_kernels, stiffness_kernels
+from ctmrpim.discretisation import assembly, rpim_kernels, stiffness_kernels
 from ctmrpim.errors import ProblemError
 
 BANDED_MAX_FRACTION = 0.1   # auto: banded Cholesky when the RCM half-bandwidth is at most this share of the dofs
@@ -81,9 +81,10 @@ def _solve(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, solver: str) -> 
 def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray
                 ) -> tuple[sp.csr_matrix | sp.csc_matrix, np.ndarray]:
     """K's free-free block and the right-hand side F[free] - K[free, fixed] U[fixed] (U zero on the free dofs).
-    Where numba already runs, one compiled pass builds the block as CSC (what SuperLU takes): no copies of
-    K's rows and columns on the way, which at 257 x 65 nodes are 160 MB each."""
-    if not (rpim_kernels.numba_ready() and isinstance(K, sp.csr_matrix) and K.has_sorted_indices):
+    For a large K one compiled pass builds the block as CSC (what SuperLU takes): no copies of K's rows and
+    columns on the way, which at 257 x 65 nodes are 160 MB each. The right-hand side's sums differ from
+    scipy's by round-off, so the path is chosen by size alone (a resumed run repeats the first)."""
+    if not (rpim_kernels.use_compiled(K.nnz, assembly.COMPILED_MIN_ENTRIES) and isinstance(K, sp.csr_matrix)):
         Kfree = K[free]
         return Kfree[:, free].tocsr(), F[free] - Kfree @ U
     new = np.full(K.shape[0], -1, np.int64)
@@ -98,8 +99,8 @@ def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray
 
 def _banded_cholesky(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool) -> np.ndarray | None:
     """Solve with RCM + banded Cholesky; None when the band is too wide (auto) or A is not positive definite.
-    The band is filled straight from A's arrays where numba already runs (no permuted copies of A) and
-    factorised in place."""
+    The band is filled straight from A's arrays where numba already runs (no permuted copies of A; the same
+    band bit for bit) and factorised in place."""
     perm = reverse_cuthill_mckee(A, symmetric_mode=True)
     n = A.shape[0]
     if rpim_kernels.numba_ready():

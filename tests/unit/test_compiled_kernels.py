@@ -24,14 +24,12 @@ ROUNDOFF = entry("roundoff")["max"]
 def compiled(monkeypatch):
     monkeypatch.setattr(rpim, "COMPILED_MIN_POINTS", 0)
     monkeypatch.setattr(assembly, "COMPILED_MIN_ENTRIES", 0)
-    monkeypatch.setattr("ctmrpim.discretisation.consistent_integration.COMPILED_MIN_ENTRIES", 0)
 
 
 def _numpy_paths(monkeypatch):
-    """Force the numpy paths, as in a small run before numba has started."""
+    """Force the numpy paths, as in a small run."""
     monkeypatch.setattr(rpim, "COMPILED_MIN_POINTS", 10**12)
     monkeypatch.setattr(assembly, "COMPILED_MIN_ENTRIES", 10**12)
-    monkeypatch.setattr("ctmrpim.discretisation.consistent_integration.COMPILED_MIN_ENTRIES", 10**12)
     monkeypatch.setattr("ctmrpim.discretisation.rpim_kernels.numba_ready", lambda: False)
 
 
@@ -212,7 +210,7 @@ def test_constrained_solve_builds_the_free_block_in_one_pass(monkeypatch, solver
     F, fixed, values = rng.random(n), np.array([0, 5, 7, 30, 79]), rng.random(5)
     monkeypatch.setattr("ctmrpim.discretisation.rpim_kernels.numba_ready", lambda: True)
     U1 = linear_solver.solve_constrained(A, F, fixed, values, solver)
-    monkeypatch.setattr("ctmrpim.discretisation.rpim_kernels.numba_ready", lambda: False)
+    _numpy_paths(monkeypatch)
     U0 = linear_solver.solve_constrained(A, F, fixed, values, solver)
     assert np.array_equal(U1[fixed], values)
     free = np.setdiff1d(np.arange(n), fixed)
