@@ -32,15 +32,16 @@ if TYPE_CHECKING:
 # footing-phi30). CTM-RPIM and scikit-fem P2 on the same node grids (the default 49 x 21 has the paper's node count),
 # with the load-settlement curve of the footing centre, beside the published values of Smith & Griffiths and of the
 # paper (the table below). The full run adds a coarser and a finer grid of the undrained footing, the frictional
-# footings on three clouds (h = B / 8, B / 11.4, B / 16), and at each benchmark's own resolution the sensitivity of
+# footings on three clouds (h = B / 8, B / 12, B / 16), and at each benchmark's own resolution the sensitivity of
 # the limit to the tangent (variant "elastic": the elastic-stiffness iteration, max_iterations = 100) and to the
 # iteration cap (variant "cap x2": Newton's max_iterations doubled to 30).
 NAME = "footing_bearing"
 TITLE = "Strip footing: pressure against settlement (cf. Fig. 24)"
 PRANDTL = (2.0 + math.pi) * 100.0      # kPa
 GRIDS = {"quick": [(49, 21)], "full": [(37, 16), (49, 21), (73, 31)]}
-#: the frictional footings' node spacings in the full run (B = 4 m: B / 8, B / 11.4, B / 16, the benchmarks' own)
-SPACINGS = [0.5, 0.35, 0.25]
+#: the frictional footings' node spacings in the full run (B = 4 m: B / 8, B / 12, B / 16, the benchmarks' own; each
+#: divides both domains' width and depth)
+SPACINGS = [0.5, 1 / 3, 0.25]
 #: the footing's width (every footing benchmark: the pressure on 0 <= x <= 2 m of the half model)
 B = 4.0
 #: the sensitivity variants: overrides of the benchmark's [loading]
@@ -65,9 +66,9 @@ def specs(quick: bool) -> list[CaseSpec]:
     out += [_spec("footing", ("parameters.nx=49", "parameters.ny=21"), solver, "49 x 21", variant)
             for variant in ("elastic", "cap x2") for solver in METHODS]
     for target in ("footing-phi20", "footing-phi30"):
-        out += [_spec(target, (f"parameters.h={h!r}",), solver, f"h = {h:g} m", "consistent")
+        out += [_spec(target, (f"parameters.h={h!r}",), solver, f"h = B / {B / h:g}", "consistent")
                 for h in SPACINGS for solver in METHODS]
-        out += [_spec(target, (f"parameters.h={SPACINGS[-1]!r}",), solver, f"h = {SPACINGS[-1]:g} m", variant)
+        out += [_spec(target, (f"parameters.h={SPACINGS[-1]!r}",), solver, f"h = B / {B / SPACINGS[-1]:g}", variant)
                 for variant in ("elastic", "cap x2") for solver in METHODS]
     return out
 
