@@ -206,14 +206,22 @@ def lower_bandwidth(indptr, indices, rank):
 
 
 @njit(cache=True, nogil=True)
-def fill_lower_band(indptr, indices, data, rank, ab):
+def fill_lower_band(indptr, indices, data, rank, ab, average):
     """LAPACK's lower band storage of the symmetrically permuted matrix, ab[i - j, j] = A[i, j] for i >= j in
-    the permuted numbering ``rank``, from a CSR or CSC matrix with symmetric values (one triangle is read)."""
+    the permuted numbering ``rank``, from a CSR or CSC matrix with symmetric values (one triangle is read);
+    with ``average``, of its symmetric part (A + A^T) / 2 instead, for any A (ab zero on entry)."""
     for r in range(len(indptr) - 1):
         pr = rank[r]
         for k in range(indptr[r], indptr[r + 1]):
             pc = rank[indices[k]]
-            if pr >= pc:
+            if average:
+                if pr > pc:
+                    ab[pr - pc, pc] += 0.5 * data[k]
+                elif pr < pc:
+                    ab[pc - pr, pr] += 0.5 * data[k]
+                else:
+                    ab[0, pc] += data[k]      # a diagonal entry is its own transpose
+            elif pr >= pc:
                 ab[pr - pc, pc] = data[k]
 
 

@@ -86,12 +86,12 @@ def solve_ctmrpim(case: Case) -> Result:
     # the counts that set the work of the solve, shown while it runs (the progress reporter)
     timer.lap("assembly", integration_points=len(conf.w), dofs=K.shape[0], nonzeros=int(K.nnz))
 
-    # K of the consistent schemes (their Dirichlet terms) is not symmetric: no Cholesky
+    # K of the consistent schemes (their Dirichlet terms) is not symmetric: no Cholesky on K itself
     symmetric = scheme in ("ctm", "cell-gauss")
     n_dofs, k_nnz = K.shape[0], int(K.nnz)
     system = constrained_system(K, F, fixed, fixed_values)
     del K     # one copy of the stiffness (the free block) while it is factorised
-    U = solve_free(*system, "superlu" if not symmetric and method.solver in ("auto", "banded") else method.solver)
+    U = solve_free(*system, method.solver, symmetric)
     del system
     u = U.reshape(-1, 2)
     timer.lap("solve", free_dofs=n_dofs - len(fixed))

@@ -216,3 +216,42 @@ def test_constrained_solve_builds_the_free_block_in_one_pass(monkeypatch, solver
     free = np.setdiff1d(np.arange(n), fixed)
     assert np.abs((A @ U1 - F)[free]).max() <= ROUNDOFF * np.abs(F).max()
     assert np.abs(U1 - U0).max() <= ROUNDOFF * np.abs(U0).max()
+
+
+def test_non_symmetric_solve_by_gmres_on_the_symmetric_part_matches_superlu(monkeypatch) -> None:
+    """A non-symmetric K near a symmetric positive definite one: GMRES preconditioned by the banded Cholesky of
+    its symmetric part gives SuperLU's solution to round-off, on both ways of filling the band."""
+    from ctmrpim.solvers import linear_solver
+    rng = np.random.default_rng(2)
+    n = 120
+    B = sp.random(n, n, density=0.05, random_state=3, format="csr")
+    S = (B + B.T + 8 * sp.identity(n)).tocsr()
+    skew = sp.random(n, n, density=0.05, random_state=4, format="csr") * 0.2
+    A = (S + skew - skew.T * 0.5).tocsr()
+    A.sort_indices()
+    F, fixed, values = rng.random(n), np.array([1, 9, 50]), rng.random(3)
+    calls = []
+    original = linear_solver._banded_gmres
+    monkeypatch.setattr(linear_solver, "_banded_gmres", lambda *a: calls.append(x := original(*a)) or x)
+    ref = linear_solver.solve_constrained(A, F, fixed, values, "superlu", symmetric=False)
+    for numpy_path in (False, True):
+        if numpy_path:
+            _numpy_paths(monkeypatch)
+        U = linear_solver.solve_constrained(A, F, fixed, values, "banded", symmetric=False)
+        assert calls[-1] is not None                                  # GMRES, not the fallback
+        assert np.abs(U - ref).max() <= 1e3 * ROUNDOFF * np.abs(ref).max()
+
+
+def test_band_of_the_symmetric_part_is_filled_from_the_matrix_itself() -> None:
+    """fill_lower_band with average: the band of (A + A^T) / 2, diagonal included, without forming A^T."""
+    from ctmrpim.discretisation import stiffness_kernels
+    A = sp.random(40, 40, density=0.2, random_state=5, format="csc") + sp.identity(40, format="csc")
+    A = (A + sp.random(40, 40, density=0.2, random_state=6, format="csc")).tocsc()
+    A = A + abs(A.T) * 0                                              # a structurally symmetric pattern
+    rank = np.random.default_rng(7).permutation(40)
+    S = ((A + A.T) * 0.5).tocsr()
+    bw = int(stiffness_kernels.lower_bandwidth(A.indptr, A.indices, rank))
+    band, ref = np.zeros((bw + 1, 40)), np.zeros((bw + 1, 40))
+    stiffness_kernels.fill_lower_band(A.indptr, A.indices, A.data, rank, band, True)
+    stiffness_kernels.fill_lower_band(S.indptr, S.indices, S.data, rank, ref, False)
+    assert np.abs(band - ref).max() <= ROUNDOFF * np.abs(ref).max()
