@@ -1,9 +1,15 @@
-"""Strip footing bearing capacity (paper Section 3.3.2, Figs. 22-24): the pressure on the flexible
-footing is raised in increments (halved near the limit) until the undrained soil (phi = psi ~ 0)
-cannot carry it; the limit pressure is the bracket [last carried, first not carried], against Prandtl's
-(2 + pi) c_u. CTM-RPIM and scikit-fem P2 on the same node grids (the default 49 x 21 has the paper's node
-count), with the load-settlement curve of the footing centre, beside the published values of Smith &
-Griffiths and of the paper (the table below). The full run adds a coarser and a finer grid.
+"""Strip footing bearing capacity (paper Section 3.3.2, Figs. 22-24): the pressure on the flexible footing is
+raised in increments until the soil cannot carry it; the limit pressure is the bracket [last carried, first not
+carried], read from the load-settlement curve: an increment whose slope of pressure against settlement from the
+last carried level falls below `loading.limit_slope` (1 %) of the elastic body's is not carried, though Newton may
+converge there, and a non-convergence counts only after a re-check with twice the iteration cap. Against Prandtl's
+(2 + pi) c_u for the undrained footing (phi = psi ~ 0) and Prandtl-Reissner's c N_c for the frictional ones
+(footing-phi20, footing-phi30). CTM-RPIM and scikit-fem P2 on the same node grids (the default 49 x 21 has the
+paper's node count), with the load-settlement curve of the footing centre, beside the published values of Smith &
+Griffiths and of the paper (the table below). The full run adds a coarser and a finer grid of the undrained footing,
+the frictional footings on three clouds (h = B / 8, B / 12, B / 16), and at each benchmark's own resolution the
+limit's sensitivity to the tangent (variant "elastic": the elastic-stiffness iteration, max_iterations = 100) and
+to the iteration cap (variant "cap x2": Newton's max_iterations doubled to 30).
 """
 from __future__ import annotations
 
@@ -22,19 +28,6 @@ from .base import finished, new_figure
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-# Issue 19 (the report quotes the docstring above; this note is for the code):
-# Strip footing bearing capacity (paper Section 3.3.2, Figs. 22-24; issue 19): the pressure on the flexible
-# footing is raised in increments until the soil cannot carry it; the limit pressure is the bracket [last carried,
-# first not carried], read from the load-settlement curve (loading.limit_slope: an increment whose slope dq/dw from
-# the last carried level is below 1 % of the elastic body's is not carried, though Newton may converge there; a
-# non-convergence counts only after a re-check with twice the iteration cap), against Prandtl's (2 + pi) c_u for
-# the undrained footing (phi = psi ~ 0) and Prandtl-Reissner's c N_c for the frictional ones (footing-phi20,
-# footing-phi30). CTM-RPIM and scikit-fem P2 on the same node grids (the default 49 x 21 has the paper's node count),
-# with the load-settlement curve of the footing centre, beside the published values of Smith & Griffiths and of the
-# paper (the table below). The full run adds a coarser and a finer grid of the undrained footing, the frictional
-# footings on three clouds (h = B / 8, B / 12, B / 16), and at each benchmark's own resolution the sensitivity of
-# the limit to the tangent (variant "elastic": the elastic-stiffness iteration, max_iterations = 100) and to the
-# iteration cap (variant "cap x2": Newton's max_iterations doubled to 30).
 NAME = "footing_bearing"
 TITLE = "Strip footing: pressure against settlement (cf. Fig. 24)"
 PRANDTL = (2.0 + math.pi) * 100.0      # kPa
@@ -142,7 +135,7 @@ def figure(df: pd.DataFrame) -> Figure:
                                 f"{r.limit_failed_kPa:.1f}] kPa")
         ax.axhline(1.0, color="k", lw=0.8, label="Prandtl-Reissner c N_c")
         ax.set(xlabel="settlement of the footing centre / B", ylabel="pressure / c N_c", ylim=(0, 1.1),
-               title="Frictional footings (issue 19)")
+               title="Frictional footings")
     return finished(fig, axes, fontsize=7)
 
 

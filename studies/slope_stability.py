@@ -2,12 +2,17 @@
 the two candidate geometries of Fig. 18 - `slope` (Smith & Griffiths 6.4 embankment) and `slope-gl`
 (Griffiths & Lane 1999, Example 1) - as a bracket [last stable SRF, first failed SRF], CTM-RPIM and
 scikit-fem P2 on the same nodes with the same PlasticSystem, return mapping and search (bracket by
-0.1 from SRF = 1 continuing from the last stable state, then bisection to 0.01; failure = non-convergence
-of the equilibrium iteration, see ctmrpim.solvers.strength_reduction), against Bishop's simplified method computed by us
+0.1 from SRF = 1 continuing from the last stable state, then bisection to 0.01; a level fails when its
+displacement runs away - the largest displacement from the stable level below, per unit relative SRF rise, above
+100 times the largest at SRF = 1 - or when the equilibrium iteration does not converge even with twice its cap,
+see ctmrpim.solvers.strength_reduction), against Bishop's simplified method computed by us
 for each geometry (critical circle searched), and the published values (the side-by-side table above).
 Node spacing h: the default clouds (0.58 m for `slope`, close to the paper's node count; 0.35 m for
 `slope-gl`) in the full run, beside coarser ones (1.0 m and 0.6 m) that show the trend with resolution;
-quick mode runs the coarser ones only.
+quick mode runs the coarser ones only. The full run adds the vertical cut in undrained clay (against Taylor's
+stability number and our Bishop search) on three clouds and, on each benchmark's own cloud, the sensitivity of the
+factor of safety to the tangent (variant "consistent": Newton, max_iterations = 15) and to the iteration cap
+(variant "cap x2": the elastic-stiffness iteration's max_iterations doubled to 200).
 """
 from __future__ import annotations
 
@@ -26,22 +31,6 @@ from .base import finished, new_figure
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-# Issue 19 (the report quotes the docstring above; this note is for the code):
-# Slope stability by strength reduction (paper Section 3.3.1, Figs. 18-20): the factor of safety of
-# the two candidate geometries of Fig. 18 - `slope` (Smith & Griffiths 6.4 embankment) and `slope-gl`
-# (Griffiths & Lane 1999, Example 1) - as a bracket [last stable SRF, first failed SRF], CTM-RPIM and
-# scikit-fem P2 on the same nodes with the same PlasticSystem, return mapping and search (bracket by
-# 0.1 from SRF = 1 continuing from the last stable state, then bisection to 0.01; a level fails when its
-# displacement runs away - the largest displacement from the stable level below, per unit relative SRF rise, above
-# 100 times the largest at SRF = 1 - or when the equilibrium iteration does not converge even with twice its cap,
-# see ctmrpim.solvers.strength_reduction), against Bishop's simplified method computed by us
-# for each geometry (critical circle searched), and the published values (the side-by-side table above).
-# Node spacing h: the default clouds (0.58 m for `slope`, close to the paper's node count; 0.35 m for
-# `slope-gl`) in the full run, beside coarser ones (1.0 m and 0.6 m) that show the trend with resolution;
-# quick mode runs the coarser ones only. The full run adds the vertical cut (issue 19: Taylor's 1.50, our Bishop
-# 1.4999) on three clouds and, on each benchmark's own cloud, the sensitivity of the factor of safety to the
-# tangent (variant "consistent": Newton, max_iterations = 15) and to the iteration cap (variant "cap x2": the
-# elastic-stiffness iteration's max_iterations doubled to 200).
 NAME = "slope_stability"
 TITLE = "Slope factor of safety by strength reduction (cf. Figs. 18-19)"
 SPACING = {"slope": {"quick": [1.0], "full": [1.0, 0.58]}, "slope-gl": {"quick": [0.6], "full": [0.6, 0.35]},
