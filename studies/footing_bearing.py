@@ -8,8 +8,8 @@ converge there, and a non-convergence counts only after a re-check with twice th
 paper's node count), with the load-settlement curve of the footing centre, beside the published values of Smith &
 Griffiths and of the paper (the table below). The full run adds a coarser and a finer grid of the undrained footing,
 the frictional footings on three clouds (h = B / 8, B / 12, B / 16), and at each benchmark's own resolution the
-limit's sensitivity to the tangent (variant "elastic": the elastic-stiffness iteration, max_iterations = 100) and
-to the iteration cap (variant "cap x2": Newton's max_iterations doubled to 30).
+limit's sensitivity to the tangent (variant "elastic": the elastic-stiffness iteration, with a higher cap) and
+to the iteration cap (variant "cap x2": Newton's max_iterations doubled).
 """
 from __future__ import annotations
 

@@ -4,15 +4,15 @@ the two candidate geometries of Fig. 18 - `slope` (Smith & Griffiths 6.4 embankm
 scikit-fem P2 on the same nodes with the same PlasticSystem, return mapping and search (bracket by
 0.1 from SRF = 1 continuing from the last stable state, then bisection to 0.01; a level fails when its
 displacement runs away - the largest displacement from the stable level below, per unit relative SRF rise, above
-100 times the largest at SRF = 1 - or when the equilibrium iteration does not converge even with twice its cap,
+`strength-reduction.limit_growth` times the largest at SRF = 1 - or when the equilibrium iteration does not converge even with twice its cap,
 see ctmrpim.solvers.strength_reduction), against Bishop's simplified method computed by us
 for each geometry (critical circle searched), and the published values (the side-by-side table above).
 Node spacing h: the default clouds (0.58 m for `slope`, close to the paper's node count; 0.35 m for
 `slope-gl`) in the full run, beside coarser ones (1.0 m and 0.6 m) that show the trend with resolution;
 quick mode runs the coarser ones only. The full run adds the vertical cut in undrained clay (against Taylor's
 stability number and our Bishop search) on three clouds and, on each benchmark's own cloud, the sensitivity of the
-factor of safety to the tangent (variant "consistent": Newton, max_iterations = 15) and to the iteration cap
-(variant "cap x2": the elastic-stiffness iteration's max_iterations doubled to 200).
+factor of safety to the tangent (variant "consistent": Newton with its own cap) and to the iteration cap
+(variant "cap x2": the elastic-stiffness iteration's max_iterations doubled).
 """
 from __future__ import annotations
 
