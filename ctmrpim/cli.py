@@ -132,6 +132,11 @@ def describe(result: Result, case: Case) -> str:
                          f"(peak traction; "
                          f"load factor {result.outcome['limit_load_factor']['carried']:.5g} .. "
                          f"{result.outcome['limit_load_factor']['failed']:.5g})")
+            crit = result.outcome.get("limit_criterion")
+            if crit is not None:
+                lines.append(f"  decided by {crit['decided_by']}; settlement at the carried level "
+                             f"{crit['settlement_at_carried']:.4g} (load-weighted mean), criterion: dq/dw at least "
+                             f"{crit['limit_slope']:g} of the elastic slope")
     dyn = result.outcome.get("dynamics")
     if dyn is not None:
         e, dt = dyn["energy"], dyn["dt"]
