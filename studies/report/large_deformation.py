@@ -12,12 +12,23 @@ import pandas as pd
 import studies
 from ctmrpim import benchmarks
 from ctmrpim.reference.elastica import tip_load_elliptic
-from studies import deformed_shapes, tolerances
+from studies import deformed_shapes, provenance, tolerances
 from studies.fe_references import converged_table, converged_tip_load
 from studies.report.markdown import Progress, Writer, md, sci, span
 
 
-def write_tip_load(w: Writer, tip: pd.DataFrame, fe: pd.DataFrame | None = None) -> None:
+def full_table(out_dir: Path | None, name: str) -> tuple[pd.DataFrame | None, str]:
+    """The committed full-mode table of study ``name`` under ``out_dir/full`` (None where there is none) and its
+    provenance state in words (a stale one is quoted as flagged, :mod:`studies.provenance`)."""
+    full = Path(out_dir) / "full" if out_dir is not None else None
+    if full is None or not (full / f"{name}.csv").is_file():
+        return None, ""
+    state = provenance.status(full, name)
+    return pd.read_csv(full / f"{name}.csv"), (state.state if state.usable else f"**{state.state}**")
+
+
+def write_tip_load(w: Writer, tip: pd.DataFrame, fe: pd.DataFrame | None = None,
+                   out_dir: Path | None = None) -> None:
     """The tip-loaded cantilever against the elastica (Figs. 13-14), and the converged FEniCSx value of the
     continuum beam (with CTM-RPIM's distance from it from the three-codes study's rows ``fe``)."""
     w("## Large deflection: tip-loaded cantilever (cf. Figs. 13-14)\n\n")
@@ -54,8 +65,21 @@ def write_tip_load(w: Writer, tip: pd.DataFrame, fe: pd.DataFrame | None = None)
         w(f"With the paper's corner load the tip deflects {span(100 * ratio.dropna(), '.1f')} % more, and the "
           f"elastica with the matching end moment predicts {span(100 * exact.dropna(), '.1f')} %. ")
     _converged(w, fe)
-    w("The paper's seven loads (full mode), the UL run with carried points and the beam turned against the CTM "
-      "lines are not committed as tables (`reports/full/tip_load.csv`), so they are not quoted.\n\n")
+    full, state = full_table(out_dir, "tip_load")
+    if full is not None and full is not tip:
+        f = full[(full.status == "ok") & (full.load == "end shear")]
+        parts = [f"{label} {span(100 * d.w_rel_diff, '+.2f')} %" for label, d in (
+            ("total-Lagrangian CTM-RPIM", f[(f.method == "ctm-rpim") & (f.formulation == "TL")]),
+            ("updated-Lagrangian CTM-RPIM", f[(f.method == "ctm-rpim") & (f.formulation == "UL")]),
+            ("scikit-fem P2", f[f.method == "fem-p2"])) if len(d)]
+        w(f"The full run (`reports/full/tip_load.csv`, {state}) at the paper's loads lambda = "
+          f"{', '.join(f'{v:g}' for v in sorted(f.lam.unique()))} on {span(f.nodes, 'd')} nodes: w/L against the "
+          f"elastica {'; '.join(parts)}. ")
+        w("The UL run with carried points and the beam turned against the CTM lines are not committed as tables, "
+          "so they are not quoted.\n\n")
+    else:
+        w("The paper's seven loads (full mode), the UL run with carried points and the beam turned against the CTM "
+          "lines are not committed as tables (`reports/full/tip_load.csv`), so they are not quoted.\n\n")
 
 
 def _converged(w: Writer, fe: pd.DataFrame | None) -> None:
@@ -82,7 +106,7 @@ def _converged(w: Writer, fe: pd.DataFrame | None) -> None:
               f"study) lies {r['ctm-rpim_rel_diff']:+.3%} from it in u_y. ")
 
 
-def write_end_moment(w: Writer, moment: pd.DataFrame) -> None:
+def write_end_moment(w: Writer, moment: pd.DataFrame, out_dir: Path | None = None) -> None:
     """The cantilever under an end moment against the exact circle (Figs. 16-17)."""
     w("## Large deflection: end moment (cf. Figs. 16-17)\n\n")
     w(f"{studies.study('end_moment').__doc__.strip()}\n\n")
@@ -106,8 +130,15 @@ def write_end_moment(w: Writer, moment: pd.DataFrame) -> None:
                   "closest CTM-RPIM variant")
             w(". ")
     if not (ok.m >= 1).any():
-        w("The ring (m up to 1: gap and mid-line) runs in full mode, and no full-mode table of it is committed "
-          "(`reports/full/end_moment.csv`), so it is not quoted. ")
+        full, state = full_table(out_dir, "end_moment")
+        ring = full[(full.status == "ok") & (full.m >= 1)] if full is not None else ()
+        if len(ring):
+            w(f"The ring, from the full run (`reports/full/end_moment.csv`, {state}): at m = {ring.m.max():g} the tip "
+              "lies " + ", ".join(f"{r.tip_distance_over_L:.4f} L ({r.formulation} {r.method})"
+                                  for _, r in ring.iterrows()) + " from the exact closed circle's. ")
+        else:
+            w("The ring (m up to 1: gap and mid-line) runs in full mode, and no full-mode table of it is committed "
+              "(`reports/full/end_moment.csv`), so it is not quoted. ")
     w("How the moment is applied decides this benchmark: with tractions that each turn with their own boundary "
       "segment, a face that does not stay exactly straight turns its two tractions by slightly different angles, "
       "the couple gets a net force, and the ring's lever arm (up to L / pi) turns that into too much curvature - "

@@ -98,9 +98,9 @@ def render(reports: Path = REPORTS) -> tuple[str, set[str]]:
                                                      scheme_table(t("integration_schemes"))))
     section("Three codes on the same problems: CTM-RPIM, scikit-fem and FEniCSx (not in the paper)", ("fe_references",), lambda: write_fe_references(w, t("fe_references")))
     section("Large deflection: tip-loaded cantilever (cf. Figs. 13-14)", ("tip_load",),
-            lambda: large_deformation.write_tip_load(w, t("tip_load"), t("fe_references")))
+            lambda: large_deformation.write_tip_load(w, t("tip_load"), t("fe_references"), reports))
     section("Large deflection: end moment (cf. Figs. 16-17)", ("end_moment",),
-            lambda: large_deformation.write_end_moment(w, t("end_moment")))
+            lambda: large_deformation.write_end_moment(w, t("end_moment"), reports))
     w(f"### Deformed configurations (cf. Figs. 15 and 17)\n\n{deformed_shapes.__doc__.strip()}\n\n")
     section("Stability: the paper, CTM-RPIM, finite elements and the analytical values side by side",
             ("slope_stability", "footing_bearing"),
