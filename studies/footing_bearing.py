@@ -9,7 +9,8 @@ paper's node count), with the load-settlement curve of the footing centre, besid
 Griffiths and of the paper (the table below). The full run adds a coarser and a finer grid of the undrained footing,
 the frictional footings on three clouds (h = B / 8, B / 12, B / 16), and at each benchmark's own resolution the
 limit's sensitivity to the tangent (variant "elastic": the elastic-stiffness iteration, with a higher cap) and
-to the iteration cap (variant "cap x2": Newton's max_iterations doubled).
+to the iteration cap (variant "cap x2": Newton's max_iterations doubled); at h = B / 8 the frictional footings'
+domains enlarged by half (variant "domain x1.5") show that the mechanism lies inside them.
 """
 from __future__ import annotations
 
@@ -40,6 +41,9 @@ B = 4.0
 #: the sensitivity variants: overrides of the benchmark's [loading]
 VARIANTS = {"consistent": (), "elastic": ('loading.tangent="elastic"', "loading.max_iterations=100"),
             "cap x2": ("loading.max_iterations=30",)}
+#: the frictional footings' domains enlarged by half in both directions (W x D: 16 x 7 -> 24 x 10.5 m at
+#: phi = 20 deg, 24 x 10 -> 36 x 15 m at phi = 30 deg), at h = B / 8: the limit must not move by 0.5 %
+ENLARGED = {"footing-phi20": (24.0, 10.5), "footing-phi30": (36.0, 15.0)}
 METHODS = ("ctm-rpim", "fem")
 
 
@@ -63,6 +67,12 @@ def specs(quick: bool) -> list[CaseSpec]:
                 for h in SPACINGS for solver in METHODS]
         out += [_spec(target, (f"parameters.h={SPACINGS[-1]!r}",), solver, f"h = B / {B / SPACINGS[-1]:g}", variant)
                 for variant in ("elastic", "cap x2") for solver in METHODS]
+        W, D = ENLARGED[target]
+        out += [CaseSpec(target, (f"parameters.h={SPACINGS[0]!r}", f"parameters.W={W!r}", f"parameters.D={D!r}"),
+                         solver, element_for(solver, "p2"),
+                         labels=(("benchmark", target), ("grid", f"h = B / {B / SPACINGS[0]:g}"),
+                                 ("variant", "domain x1.5")))
+                for solver in METHODS]
     return out
 
 
@@ -102,6 +112,8 @@ def extra(summary: dict) -> dict:
             "settlement_at_carried_m": criterion.get("settlement_at_carried"),
             "centre_settlement_over_B": float(w[-1] / B) if len(w) else float("nan"),
             "tangent": loading["tangent"], "max_iterations": loading["max_iterations"],
+            "domain_W_m": summary["parameters"]["parameters"].get("W"),
+            "domain_D_m": summary["parameters"]["parameters"].get("D"),
             "safeguarded_steps": summary["counts"].get("safeguarded_steps"),
             "settlement_at_500_kPa_m": at500, "newton_iterations": summary["counts"]["newton_iterations"],
             "curve": json.dumps({"q_kPa": q.round(3).tolist(), "w_m": w.tolist()})}

@@ -15,6 +15,11 @@ silently), *modified* when the table or figure no longer hashes as stamped (rewr
 *unstamped* without a sidecar. ``python -m studies.provenance reports/full`` prints every result's state;
 ``--stamp NAME --commit SHA`` stamps a result made before stamping existed with the sources of the commit that
 committed it (what the run can at best be traced to).
+
+A source is hashed as the sweep cache hashes it (:func:`ctmrpim.io.provenance.file_digest`: Python without
+docstrings, comments and blank lines), and a study module without its ``figure`` function, which draws the table
+and computes nothing in it: after an edit there, ``--redraw NAME`` draws the figure again from the committed table
+and records the new figure's hash, and the result stays current.
 """
 from __future__ import annotations
 
@@ -27,7 +32,7 @@ import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ctmrpim.io.provenance import PRESENTATION
+from ctmrpim.io.provenance import PRESENTATION, file_digest, normalised_source
 from ctmrpim.version import __version__
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,6 +41,8 @@ SUFFIX = ".provenance.json"
 OUTPUTS = (".csv", ".png")
 #: modules of ``studies`` that compute nothing (executor, command line, report): not numerics sources
 NOT_NUMERICS = ("studies.sweep", "studies.cli", "studies.commands", "studies.report", "studies.provenance")
+#: top-level functions of a study module that draw its table and compute nothing in it
+DRAWING = ("figure",)
 
 
 def _package_files(root: Path, package: str) -> list[str]:
@@ -89,9 +96,26 @@ def _sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
+def _without_drawing(text: str) -> str:
+    """A study module's source without its :data:`DRAWING` functions (decorators included)."""
+    lines = text.splitlines()
+    for node in ast.parse(text).body:
+        if isinstance(node, ast.FunctionDef) and node.name in DRAWING:
+            start = min([node.lineno] + [d.lineno for d in node.decorator_list]) - 1
+            lines[start:node.end_lineno] = [""] * (node.end_lineno - start)
+    return "\n".join(lines) + "\n"
+
+
+def _digest(path: Path, study_module: bool) -> str:
+    """sha256 (16 hex digits) of one numerics source: :func:`file_digest`, a study module without its drawing."""
+    if study_module:
+        return _sha(normalised_source(_without_drawing(path.read_text())).encode())[:16]
+    return file_digest(path)[:16]
+
+
 def fingerprint(study: str, root: Path = ROOT) -> dict[str, str]:
     """sha256 (16 hex digits) of each numerics source of ``study`` in the tree at ``root``."""
-    return {f: _sha((root / f).read_bytes())[:16] for f in numerics_files(study, root)}
+    return {f: _digest(root / f, f.startswith("studies/")) for f in numerics_files(study, root)}
 
 
 def _git(*args: str, root: Path = ROOT) -> str | None:
@@ -207,15 +231,40 @@ def studies_in(out_dir: Path) -> list[str]:
     return sorted(names)
 
 
+def redraw(out_dir: Path, study: str) -> Path:
+    """Draw ``study``'s figure again from its table in ``out_dir`` with the current ``figure`` function and
+    record the figure's new hash in the sidecar (its sources unchanged: drawing computes nothing); the PNG's
+    path."""
+    import importlib
+
+    import pandas as pd
+
+    from studies.base import save_figure
+
+    out_dir = Path(out_dir)
+    path = sidecar(out_dir, study)
+    rec = json.loads(path.read_text())
+    png = save_figure(importlib.import_module(f"studies.{study}").figure(pd.read_csv(out_dir / f"{study}.csv")),
+                      out_dir / f"{study}.png")
+    rec["files"][png.name] = _sha(png.read_bytes())
+    rec["figure_redrawn"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    path.write_text(json.dumps(rec, indent=1, sort_keys=True) + "\n")
+    return png
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m studies.provenance", description=__doc__.split("\n\n")[0])
     parser.add_argument("out_dir", type=Path, nargs="?", default=Path("reports/full"))
     parser.add_argument("--stamp", metavar="STUDY", action="append", default=[],
                         help="write the sidecar of STUDY's result (repeatable)")
     parser.add_argument("--commit", help="with --stamp: the commit whose sources made the result")
+    parser.add_argument("--redraw", metavar="STUDY", action="append", default=[],
+                        help="draw STUDY's figure again from its table (repeatable)")
     args = parser.parse_args(argv)
     for name in args.stamp:
         print(f"stamped {stamp(args.out_dir, name, args.commit)}")
+    for name in args.redraw:
+        print(f"redrawn {redraw(args.out_dir, name)}")
     for name in studies_in(args.out_dir):
         s = status(args.out_dir, name)
         print(f"{name}: {s.state}: {s.describe()}")

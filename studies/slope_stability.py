@@ -8,8 +8,8 @@ displacement runs away - the largest displacement from the stable level below, p
 see ctmrpim.solvers.strength_reduction), against Bishop's simplified method computed by us
 for each geometry (critical circle searched), and the published values (the side-by-side table above).
 Node spacing h: the default clouds (0.58 m for `slope`, close to the paper's node count; 0.35 m for
-`slope-gl`) in the full run, beside coarser ones (1.0 m and 0.6 m) that show the trend with resolution;
-quick mode runs the coarser ones only. The full run adds the vertical cut in undrained clay (against Taylor's
+`slope-gl`) in the full run, beside a coarser (1.0 m, 0.6 m) and a finer one (0.42 m, 0.25 m): three clouds that
+show the trend with resolution; quick mode runs the coarser ones only. The full run adds the vertical cut in undrained clay (against Taylor's
 stability number and our Bishop search) on three clouds and, on each benchmark's own cloud, the sensitivity of the
 factor of safety to the tangent (variant "consistent": Newton with its own cap) and to the iteration cap
 (variant "cap x2": the elastic-stiffness iteration's max_iterations doubled).
@@ -33,8 +33,11 @@ if TYPE_CHECKING:
 
 NAME = "slope_stability"
 TITLE = "Slope factor of safety by strength reduction (cf. Figs. 18-19)"
-SPACING = {"slope": {"quick": [1.0], "full": [1.0, 0.58]}, "slope-gl": {"quick": [0.6], "full": [0.6, 0.35]},
+SPACING = {"slope": {"quick": [1.0], "full": [1.0, 0.58, 0.42]},
+           "slope-gl": {"quick": [0.6], "full": [0.6, 0.35, 0.25]},
            "vertical-cut": {"quick": [], "full": [1.0, 0.5, 0.35]}}
+#: each benchmark's own node spacing (its file's), where the full run adds the sensitivity variants
+OWN_SPACING = {"slope": 0.58, "slope-gl": 0.35, "vertical-cut": 0.35}
 PAPER = (1.3, 1.4)
 #: the sensitivity variants (full run, each benchmark's own cloud): overrides of the benchmark's [loading]
 VARIANTS = {"default": (), "consistent": ('loading.tangent="consistent"', "loading.max_iterations=15"),
@@ -54,7 +57,7 @@ def specs(quick: bool) -> list[CaseSpec]:
     out = []
     for target, hs in SPACING.items():
         for h in hs[mode]:
-            variants = ("default",) if quick or h != hs[mode][-1] else tuple(VARIANTS)
+            variants = ("default",) if quick or h != OWN_SPACING[target] else tuple(VARIANTS)
             out += [CaseSpec(target, (f"parameters.h={h!r}",) + VARIANTS[v], solver, element_for(solver, "p2"),
                              labels=(("slope", target), ("h", h), ("variant", v)))
                     for v in variants for solver in ("ctm-rpim", "fem")]

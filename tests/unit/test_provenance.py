@@ -64,6 +64,33 @@ def test_a_changed_source_makes_it_stale(made) -> None:
     assert "2 numerics" not in s.describe(count=False)
 
 
+def test_docstrings_comments_and_drawing_do_not_make_it_stale(made) -> None:
+    """Only an edit that can change a number counts: a docstring, a comment, a blank line or the study's figure
+    function leaves the result current; a redrawn figure is recorded and stays current."""
+    root, out = made
+    (root / "ctmrpim/solver.py").write_text('"""The solver."""\n\n# why x is one\nx = 1   # one\n')
+    (root / "studies/demo.py").write_text((root / "studies/demo.py").read_text()
+                                          + "\n\ndef figure(df):\n    return df.plot().figure\n")
+    assert provenance.status(out, "demo", root).state == "current"
+    (root / "ctmrpim/solver.py").write_text('"""The solver."""\nx = 2\n')
+    assert provenance.status(out, "demo", root).state == "stale"
+
+
+def test_redraw_records_the_new_figure(tmp_path: Path) -> None:
+    """``redraw`` draws a committed study's figure from its table with the current code; the sidecar then
+    describes the new PNG, and the result is not taken for rewritten."""
+    import shutil
+    full = ROOT / "reports" / "full"
+    if not (full / "support_radius.csv").is_file():
+        pytest.skip("no committed full-mode results")
+    for suffix in (".csv", ".png", provenance.SUFFIX):
+        shutil.copy(full / f"support_radius{suffix}", tmp_path)
+    before = provenance.status(tmp_path, "support_radius").state
+    png = provenance.redraw(tmp_path, "support_radius")
+    assert png.stat().st_size > 10_000
+    assert provenance.status(tmp_path, "support_radius").state == before
+
+
 def test_a_rewritten_result_is_modified_and_a_missing_record_unstamped(made) -> None:
     root, out = made
     (out / "demo.csv").write_text("a,b\n1,3\n")

@@ -41,7 +41,12 @@ def test_cache_key_hashes_only_the_code_that_computes_results(tmp_path) -> None:
     before = source_hash(copy, PRESENTATION)
     (copy / "cli.py").write_text((copy / "cli.py").read_text().replace("list the benchmark problems", "list them"))
     assert source_hash(copy, PRESENTATION) == before
-    (copy / "discretisation" / "rpim.py").write_text((copy / "discretisation" / "rpim.py").read_text() + "\n# edited\n")
+    rpim = copy / "discretisation" / "rpim.py"
+    rpim.write_text(rpim.read_text() + "\n# a comment, and a docstring edited\n".replace("docstring", "doc"))
+    text = rpim.read_text()
+    rpim.write_text(text.replace('"""', '"""Edited. ', 1))
+    assert source_hash(copy, PRESENTATION) == before   # comments and docstrings compute nothing
+    rpim.write_text(text + "\nEDITED = 1\n")
     assert source_hash(copy, PRESENTATION) != before
     # the finite-element method's version adds reference_fem's sources, and nothing of studies/
     assert method_version("fem").startswith(method_version("ctm-rpim") + "+reference_fem-")

@@ -15,8 +15,8 @@ yields), lagged by one step as explicit codes do; a mode of frequency omega gets
 beta omega / 2, and the stable step becomes cfl 2 / omega_max (sqrt(1 + z^2) - z), z = beta omega_max / 2
 (:mod:`ctmrpim.solvers.explicit.time_step`).
 Why: the paper's model (rate-independent Mohr-Coulomb, no damping) lets the surface layer of the
-collapsed column slide on long after the flow has stopped (measured on 496 nodes: still moving at 1 s,
-the surface flattened to 11.5 deg against 14.6 deg measured); SPH models of granular flow, the method the
+collapsed column slide on long after the flow has stopped (on 496 nodes it still moved at 1 s and its
+surface flattened well below the experiment's; study ``column_collapse_viscosity`` has the numbers); SPH models of granular flow, the method the
 experiment was first compared with, carry an artificial viscosity, and a real granular flow's friction
 grows with its shear rate (the mu(I) rheology), which a rate-independent model lacks. The value is a
 setting, fitted for the benchmark (study ``column_collapse_viscosity``). The per-point work is in
