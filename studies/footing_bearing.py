@@ -119,36 +119,66 @@ def extra(summary: dict) -> dict:
             "curve": json.dumps({"q_kPa": q.round(3).tolist(), "w_m": w.tolist()})}
 
 
+def _settlement_axis(ax, values: list[np.ndarray]) -> None:
+    """Scale the settlement (y) axis of ``ax`` so that every one of ``values`` shows: logarithmic where the
+    settlements span more than two decades (a failing footing's last iterate far beyond the carried ones;
+    symmetric-log, linear below the smallest non-zero settlement, where some are zero or negative), linear from
+    zero otherwise; no fixed limit clips a point."""
+    from matplotlib.ticker import FuncFormatter
+
+    every = np.concatenate(values) if values else np.zeros(0)
+    positive = np.abs(every[every != 0])
+    if not len(positive) or positive.max() <= 100 * positive.min():
+        if len(every) and every.min() >= 0:
+            ax.set_ylim(bottom=0)
+        return
+    if np.all(every > 0):
+        ax.set_yscale("log")
+    else:
+        ax.set_yscale("symlog", linthresh=float(positive.min()))
+    plain = FuncFormatter(lambda v, _: f"{v:g}")
+    ax.yaxis.set_major_formatter(plain)
+
+
 def figure(df: pd.DataFrame) -> Figure:
-    """Pressure against the settlement of the footing centre for every case of the undrained footing, with
-    Prandtl's limit and the published points (cf. Fig. 24); beside it, the frictional footings' pressure over
-    c N_c against the centre's settlement over B (the full run)."""
+    """The settlement of the footing centre against the pressure for every case of the undrained footing, the
+    paper's way round (maximum displacement versus bearing stress, Fig. 24), with Prandtl's limit and the
+    published points; beside it, the frictional footings' settlement over B against their pressure over c N_c
+    (the full run). Every point shows: the settlement axis is logarithmic where it spans decades."""
     ok = df[(df.status == "ok") & (df.get("variant", "consistent") == "consistent")]
     undrained = ok[ok.get("benchmark", "footing") == "footing"]
     frictional = ok[ok.get("benchmark", "footing") != "footing"]
     fig, axes = new_figure(2 if len(frictional) else 1, 6.0)
     ax = axes[0, 0]
     styles = {"ctm-rpim": "-", "fem-p2": "--"}
+    shown = []
     for _, r in undrained.iterrows():
         c = json.loads(r.curve)
-        ax.plot(np.array(c["w_m"]) * 100, c["q_kPa"], styles[r.method], marker=".", ms=3,
+        shown.append(np.array(c["w_m"]) * 100)
+        ax.plot(c["q_kPa"], shown[-1], styles[r.method], marker=".", ms=3,
                 label=f"{r.method}, {r.grid}: limit {r.limit_carried_kPa:.1f}-{r.limit_failed_kPa:.1f} kPa")
-    ax.axhline(PRANDTL, color="k", lw=0.8, label="Prandtl (2 + pi) c_u = 514.2 kPa")
-    ax.plot([5.1], [500], "ks", mfc="none", label="Smith & Griffiths: 5.1 cm at 500 kPa")
-    ax.plot([6.0], [500], "k^", mfc="none", label="paper: about 6 cm at 500 kPa")
-    ax.set(xlabel="settlement of the footing centre (cm)", ylabel="pressure (kPa)", xlim=(0, 30), ylim=(0, 560),
-           title=TITLE)
+    ax.axvline(PRANDTL, color="k", lw=0.8, label="Prandtl (2 + pi) c_u = 514.2 kPa")
+    ax.plot([500], [5.1], "ks", mfc="none", label="Smith & Griffiths: 5.1 cm at 500 kPa")
+    ax.plot([500], [6.0], "k^", mfc="none", label="paper: about 6 cm at 500 kPa")
+    _settlement_axis(ax, [*shown, np.array([5.1, 6.0])])
+    ax.set(xlabel="bearing pressure (kPa)", ylabel="settlement of the footing centre (cm)",
+           title="Strip footing: settlement against pressure (cf. Fig. 24)")
+    ax.set_xlim(left=0)
     if len(frictional):
         ax = axes[0, 1]
+        shown = []
         for _, r in frictional.iterrows():
             c = json.loads(r.curve)
-            ax.plot(np.array(c["w_m"]) / B, np.array(c["q_kPa"]) / r.reference_kPa, styles[r.method], marker=".",
+            shown.append(np.array(c["w_m"]) / B)
+            ax.plot(np.array(c["q_kPa"]) / r.reference_kPa, shown[-1], styles[r.method], marker=".",
                     ms=3, label=f"{r.benchmark}, {r.method}, {r.grid}: [{r.limit_carried_kPa:.1f}, "
                                 f"{r.limit_failed_kPa:.1f}] kPa")
-        ax.axhline(1.0, color="k", lw=0.8, label="Prandtl-Reissner c N_c")
-        ax.set(xlabel="settlement of the footing centre / B", ylabel="pressure / c N_c", ylim=(0, 1.1),
+        ax.axvline(1.0, color="k", lw=0.8, label="Prandtl-Reissner c N_c")
+        _settlement_axis(ax, shown)
+        ax.set(xlabel="pressure / c N_c", ylabel="settlement of the footing centre / B",
                title="Frictional footings")
-    return finished(fig, axes, fontsize=7)
+        ax.set_xlim(left=0)
+    return finished(fig, axes, "both", fontsize=7)
 
 
 if __name__ == "__main__":

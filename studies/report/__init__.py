@@ -5,7 +5,7 @@ every claim of the paper against the tolerances table, and writes them side by s
 statement, our value, the analytical reference, the finite-element value, pass/fail.
 
 ``make_report`` (here) runs the studies and writes the sections in order; ``checks`` holds the
-tolerance checks, ``markdown`` the table formatting, and ``summary``, ``linear``,
+tolerance checks, ``markdown`` the table formatting, and ``summary``, ``models``, ``linear``,
 ``large_deformation``, ``stability``, ``dynamics``, ``fe_references`` and ``nonlinear_schemes`` one function per section.
 """
 from __future__ import annotations
@@ -17,7 +17,7 @@ import studies
 from ctmrpim.io.atomic import atomic_write_text
 from studies import explicit_conservation
 from studies.integration_schemes import scheme_table
-from studies.report import dynamics, large_deformation, linear, stability, summary
+from studies.report import dynamics, large_deformation, linear, models, stability, summary
 from studies.report.checks import all_checks, claims_table, console_summary
 from studies.report.fe_references import write_fe_references
 from studies.report.markdown import Progress
@@ -42,6 +42,7 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     summary.write_claims(w, claim_rows, tables)
     summary.write_accuracy_checks(w, checks)
     summary.write_provenance(w, out_dir)
+    models.write_models(w, quick, out_dir, progress)
     linear.write_node_density(w, tables["node_density"])
     linear.write_time_to_accuracy(w, targets_table(tables["time_to_accuracy"]))
     linear.write_parameter_studies(w, tables)

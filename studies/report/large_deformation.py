@@ -77,6 +77,7 @@ def write_tip_load(w: Writer, tip: pd.DataFrame, fe: pd.DataFrame | None = None,
           f"elastica {'; '.join(parts)}. ")
         w("The UL run with carried points and the beam turned against the CTM lines are not committed as tables, "
           "so they are not quoted.\n\n")
+        _full_figure(w, out_dir, "tip_load", state, "the paper's loads (cf. Fig. 14)")
     else:
         w("The paper's seven loads (full mode), the UL run with carried points and the beam turned against the CTM "
           "lines are not committed as tables (`reports/full/tip_load.csv`), so they are not quoted.\n\n")
@@ -129,8 +130,8 @@ def write_end_moment(w: Writer, moment: pd.DataFrame, out_dir: Path | None = Non
                   f"{ctm.tip_distance_over_L.min() / p2.tip_distance_over_L.iloc[0]:.0f} times closer than the "
                   "closest CTM-RPIM variant")
             w(". ")
+    full, state = full_table(out_dir, "end_moment")
     if not (ok.m >= 1).any():
-        full, state = full_table(out_dir, "end_moment")
         ring = full[(full.status == "ok") & (full.m >= 1)] if full is not None else ()
         if len(ring):
             w(f"The ring, from the full run (`reports/full/end_moment.csv`, {state}): at m = {ring.m.max():g} the tip "
@@ -145,6 +146,16 @@ def write_end_moment(w: Writer, moment: pd.DataFrame, out_dir: Path | None = Non
       "for scikit-fem P2 as much as for CTM-RPIM. The benchmark therefore turns both tractions with the end face "
       "as a whole (`follower = \"face\"`). What is left in the adaptive UL run is the rebuilds' own scatter: with "
       "the points carried (`method.point_regeneration`) the curve is smooth.\n\n")
+    if full is not None and full is not moment:
+        _full_figure(w, out_dir, "end_moment", state, "the moment up to the closed ring (cf. Fig. 17)")
+
+
+def _full_figure(w: Writer, out_dir: Path | None, name: str, state: str, what: str) -> None:
+    """The committed full-mode figure of study ``name`` (``out_dir/full/NAME.png``), beside the quick one above,
+    with its provenance ``state``; nothing where the figure is not committed."""
+    if out_dir is not None and (Path(out_dir) / "full" / f"{name}.png").is_file():
+        w(f"The full-mode figure, {what} (`reports/full/{name}.png`, {state}):\n\n"
+          f"![{name.replace('_', ' ')}, full mode](full/{name}.png)\n\n")
 
 
 def write_deformed_shapes(w: Writer, quick: bool, out_dir: Path, progress: Progress) -> None:

@@ -3,8 +3,9 @@ section writers give for the committed tables under ``reports/`` (and ``reports/
 the prose is typed into the code.
 
 The sections are re-rendered here from the committed CSVs (no study runs: each study writes its table as CSV
-before the report reads it, so the CSV is the table the report was written from). The two figure sections that
-need their own runs (deformed shapes, stability fields) print only their module docstrings, re-rendered alike.
+before the report reads it, so the CSV is the table the report was written from). The figure sections that
+need their own runs (deformed shapes, stability fields) or draw the models (Figs. 6 and 8) print only their module
+docstrings, re-rendered alike.
 """
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ import pandas as pd
 import pytest
 
 import studies
-from studies import deformed_shapes, stability_fields, tolerances
+from studies import deformed_shapes, model_figures, stability_fields, tolerances
 
 ROOT = Path(__file__).resolve().parents[2]
 REPORTS = ROOT / "reports"
@@ -84,6 +85,8 @@ def render(reports: Path = REPORTS) -> tuple[str, set[str]]:
     else:
         missing |= {"", summary.CLAIMS_HEADING, summary.PINS_HEADING}
     summary.write_provenance(w, reports)
+    from studies.report.models import HEADING
+    w(f"## {HEADING}\n\n{model_figures.__doc__.strip()}\n\n")
     t = tables.get
     section("Node density: cantilever, CTM-RPIM against scikit-fem (cf. Fig. 9)", ("node_density",),
             lambda: linear.write_node_density(w, t("node_density")))
@@ -156,8 +159,8 @@ def test_render_calls_every_writer_of_make_report() -> None:
 
     made = writers(Path(report.__file__).read_text())
     here = writers(Path(__file__).read_text())
-    # the two figure sections run their own cases: their docstrings are written here instead
-    assert made - here <= {"write_deformed_shapes", "write_stability_fields"}, made - here
+    # the figure sections run their own cases or draw their own models: their docstrings are written here instead
+    assert made - here <= {"write_deformed_shapes", "write_stability_fields", "write_models"}, made - here
 
 
 def test_every_number_of_the_report_is_read_from_its_tables() -> None:
