@@ -17,9 +17,11 @@ silently), *modified* when the table or figure no longer hashes as stamped (rewr
 committed it (what the run can at best be traced to).
 
 A source is hashed as the sweep cache hashes it (:func:`ctmrpim.io.provenance.file_digest`: Python without
-docstrings, comments and blank lines), and a study module without its ``figure`` function, which draws the table
-and computes nothing in it: after an edit there, ``--redraw NAME`` draws the figure again from the committed table
-and records the new figure's hash, and the result stays current.
+docstrings, comments and blank lines). A study module is hashed without its ``figure`` function, which draws the
+table and computes nothing in it (after an edit there, ``python -m studies.redraw NAME`` draws the figure again
+from the committed table and records the new figure's hash, and the result stays current), and without its ``specs`` function and
+what only that uses: the full run's case list itself is hashed instead (:func:`full_cases`), so a change of the
+quick mode's cases leaves a full-mode result current while any change of a full case makes it stale.
 """
 from __future__ import annotations
 
@@ -40,9 +42,12 @@ SUFFIX = ".provenance.json"
 #: the files of a study's result that a sidecar describes
 OUTPUTS = (".csv", ".png")
 #: modules of ``studies`` that compute nothing (executor, command line, report): not numerics sources
-NOT_NUMERICS = ("studies.sweep", "studies.cli", "studies.commands", "studies.report", "studies.provenance")
+NOT_NUMERICS = ("studies.sweep", "studies.cli", "studies.commands", "studies.report", "studies.provenance",
+                "studies.redraw")
 #: top-level functions of a study module that draw its table and compute nothing in it
 DRAWING = ("figure",)
+#: top-level functions of a study module that list its cases (hashed as the full run's case list instead)
+CASE_LISTING = ("specs",)
 
 
 def _package_files(root: Path, package: str) -> list[str]:
@@ -96,26 +101,94 @@ def _sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def _without_drawing(text: str) -> str:
-    """A study module's source without its :data:`DRAWING` functions (decorators included)."""
+def _defined(node: ast.stmt) -> set[str]:
+    """The module-level names a top-level statement defines (a function, a class, an assignment's targets)."""
+    if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+        return {node.name}
+    targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(
+        node, (ast.AnnAssign, ast.AugAssign)) else []
+    return {n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name)}
+
+
+def _used(nodes: list[ast.stmt]) -> set[str]:
+    """The names ``nodes`` read."""
+    return {n.id for node in nodes for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+
+
+def _without_cases_and_drawing(text: str) -> str:
+    """A study module's source without the code that only lists its cases or draws its table: the
+    :data:`CASE_LISTING` and :data:`DRAWING` functions, and the top-level definitions (helpers, constants such as
+    quick and full grids) that only they use. What the full run computes from those is hashed as its case list
+    (:func:`full_cases`)."""
+    body = ast.parse(text).body
+    gone = [n for n in body if isinstance(n, ast.FunctionDef) and n.name in DRAWING + CASE_LISTING]
+    while True:
+        kept = [n for n in body if n not in gone]
+        used_by_kept, used_by_gone = _used(kept), _used(gone)
+        more = [n for n in kept if _defined(n) and not _defined(n) & used_by_kept and _defined(n) & used_by_gone]
+        if not more:
+            break
+        gone += more
     lines = text.splitlines()
-    for node in ast.parse(text).body:
-        if isinstance(node, ast.FunctionDef) and node.name in DRAWING:
-            start = min([node.lineno] + [d.lineno for d in node.decorator_list]) - 1
-            lines[start:node.end_lineno] = [""] * (node.end_lineno - start)
+    for node in gone:
+        start = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])]) - 1
+        lines[start:node.end_lineno] = [""] * (node.end_lineno - start)
     return "\n".join(lines) + "\n"
 
 
 def _digest(path: Path, study_module: bool) -> str:
-    """sha256 (16 hex digits) of one numerics source: :func:`file_digest`, a study module without its drawing."""
+    """sha256 (16 hex digits) of one numerics source: :func:`file_digest`, a study module without its case
+    listing and drawing."""
     if study_module:
-        return _sha(normalised_source(_without_drawing(path.read_text())).encode())[:16]
+        return _sha(normalised_source(_without_cases_and_drawing(path.read_text())).encode())[:16]
     return file_digest(path)[:16]
 
 
+def _listed(specs: list, root: str) -> str:
+    """sha256 (16 hex digits) of a case list: each case's benchmark, overrides, method, element and coordinates,
+    with paths inside the tree ``root`` made relative to it (the same tree hashes alike wherever it lies)."""
+    def rel(text: str) -> str:
+        return text.replace(root.rstrip("/") + "/", "")
+    rows = [[rel(s.target), [rel(o) for o in s.overrides], s.solver, s.element, [list(kv) for kv in s.labels]]
+            for s in specs]
+    return hashlib.sha256(json.dumps(rows, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+#: run by another tree's interpreter: that tree's study lists its full cases, this module's rule hashes them
+_CASES_SCRIPT = """
+import importlib, sys
+module = importlib.import_module("studies." + sys.argv[1])
+if hasattr(module, "specs"):
+    print(listed(module.specs(False), __import__("os").getcwd()))
+"""
+
+
+def full_cases(study: str, root: Path = ROOT) -> str | None:
+    """sha256 (16 hex digits) of the full run's case list of ``study`` (each case's benchmark, overrides, method,
+    element and study coordinates, in order) as the tree at ``root`` makes it; None for a module without
+    ``specs``, "unavailable" where that tree cannot list them. The benchmark files and the code that resolves and
+    solves the cases are hashed as files."""
+    if Path(root).resolve() != ROOT:   # another tree's code: listed by an interpreter that imports it
+        import inspect
+        import os
+        import sys
+        script = f"import hashlib, json\n{inspect.getsource(_listed)}\nlisted = _listed\n{_CASES_SCRIPT}"
+        out = subprocess.run([sys.executable, "-c", script, study], cwd=root, capture_output=True, text=True,
+                             env={**os.environ, "PYTHONPATH": str(root)})
+        return (out.stdout.strip() or None) if out.returncode == 0 else "unavailable"
+    import importlib
+    module = importlib.import_module(f"studies.{study}")
+    return _listed(module.specs(False), str(ROOT)) if hasattr(module, "specs") else None
+
+
 def fingerprint(study: str, root: Path = ROOT) -> dict[str, str]:
-    """sha256 (16 hex digits) of each numerics source of ``study`` in the tree at ``root``."""
-    return {f: _digest(root / f, f.startswith("studies/")) for f in numerics_files(study, root)}
+    """sha256 (16 hex digits) of each numerics source of ``study`` in the tree at ``root``, and of its full run's
+    case list (key ``studies/NAME.py:full-cases``)."""
+    out = {f: _digest(root / f, f.startswith("studies/")) for f in numerics_files(study, root)}
+    cases = full_cases(study, root)
+    if cases is not None:
+        out[f"studies/{study}.py:full-cases"] = cases
+    return out
 
 
 def _git(*args: str, root: Path = ROOT) -> str | None:
@@ -231,40 +304,15 @@ def studies_in(out_dir: Path) -> list[str]:
     return sorted(names)
 
 
-def redraw(out_dir: Path, study: str) -> Path:
-    """Draw ``study``'s figure again from its table in ``out_dir`` with the current ``figure`` function and
-    record the figure's new hash in the sidecar (its sources unchanged: drawing computes nothing); the PNG's
-    path."""
-    import importlib
-
-    import pandas as pd
-
-    from studies.base import save_figure
-
-    out_dir = Path(out_dir)
-    path = sidecar(out_dir, study)
-    rec = json.loads(path.read_text())
-    png = save_figure(importlib.import_module(f"studies.{study}").figure(pd.read_csv(out_dir / f"{study}.csv")),
-                      out_dir / f"{study}.png")
-    rec["files"][png.name] = _sha(png.read_bytes())
-    rec["figure_redrawn"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-    path.write_text(json.dumps(rec, indent=1, sort_keys=True) + "\n")
-    return png
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m studies.provenance", description=__doc__.split("\n\n")[0])
     parser.add_argument("out_dir", type=Path, nargs="?", default=Path("reports/full"))
     parser.add_argument("--stamp", metavar="STUDY", action="append", default=[],
                         help="write the sidecar of STUDY's result (repeatable)")
     parser.add_argument("--commit", help="with --stamp: the commit whose sources made the result")
-    parser.add_argument("--redraw", metavar="STUDY", action="append", default=[],
-                        help="draw STUDY's figure again from its table (repeatable)")
     args = parser.parse_args(argv)
     for name in args.stamp:
         print(f"stamped {stamp(args.out_dir, name, args.commit)}")
-    for name in args.redraw:
-        print(f"redrawn {redraw(args.out_dir, name)}")
     for name in studies_in(args.out_dir):
         s = status(args.out_dir, name)
         print(f"{name}: {s.state}: {s.describe()}")

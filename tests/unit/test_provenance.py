@@ -12,12 +12,34 @@ from studies import provenance
 ROOT = Path(__file__).resolve().parents[2]
 
 
+#: a study with quick and full cases listed from one table of grids
+DEMO = """from studies.helper import z
+from studies.sweep import CaseSpec
+GRIDS = {"quick": [1], "full": [2, 3]}
+
+
+def specs(quick):
+    return [CaseSpec("beam", (f"n={n}",)) for n in GRIDS["quick" if quick else "full"]]
+"""
+SWEEP = """from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class CaseSpec:
+    target: str
+    overrides: tuple = ()
+    solver: str = "ctm-rpim"
+    element: object = None
+    labels: tuple = ()
+"""
+
+
 def _tree(root: Path) -> None:
     """A miniature repository: the numerics packages, a study that imports a helper, and non-numerics modules."""
     for rel, text in {"ctmrpim/solver.py": "x = 1\n", "ctmrpim/cli.py": "help = 'a'\n",
                       "ctmrpim/benchmarks/beam.toml": "L = 1\n", "reference_fem/fem.py": "y = 2\n",
-                      "studies/demo.py": "from studies.helper import z\nfrom studies.sweep import CaseSpec\n",
-                      "studies/helper.py": "z = 3\n", "studies/sweep.py": "CaseSpec = None\n",
+                      "studies/demo.py": DEMO, "studies/__init__.py": "",
+                      "studies/helper.py": "z = 3\n", "studies/sweep.py": SWEEP,
                       "studies/other.py": "w = 4\n"}.items():
         (root / rel).parent.mkdir(parents=True, exist_ok=True)
         (root / rel).write_text(text)
@@ -53,7 +75,7 @@ def test_a_fresh_stamp_is_current(made) -> None:
 
 def test_a_changed_source_makes_it_stale(made) -> None:
     root, out = made
-    (root / "studies/sweep.py").write_text("CaseSpec = 1\n")   # not a numerics source
+    (root / "studies/sweep.py").write_text(SWEEP + "\nDASK = None\n")   # not a numerics source
     (root / "ctmrpim/cli.py").write_text("help = 'b'\n")
     assert provenance.status(out, "demo", root).state == "current"
     (root / "studies/helper.py").write_text("z = 4\n")
@@ -76,8 +98,20 @@ def test_docstrings_comments_and_drawing_do_not_make_it_stale(made) -> None:
     assert provenance.status(out, "demo", root).state == "stale"
 
 
+def test_quick_cases_do_not_make_it_stale_and_full_ones_do(made) -> None:
+    """The study module's case listing is hashed as the full run's case list: another quick grid leaves the full
+    result current, another full grid makes it stale and names the case list."""
+    root, out = made
+    demo = root / "studies/demo.py"
+    demo.write_text(DEMO.replace('"quick": [1]', '"quick": [1, 5]'))
+    assert provenance.status(out, "demo", root).state == "current"
+    demo.write_text(DEMO.replace('"full": [2, 3]', '"full": [2, 4]'))
+    s = provenance.status(out, "demo", root)
+    assert s.state == "stale" and s.changed == ["studies/demo.py:full-cases"]
+
+
 def test_redraw_records_the_new_figure(tmp_path: Path) -> None:
-    """``redraw`` draws a committed study's figure from its table with the current code; the sidecar then
+    """``studies.redraw`` draws a committed study's figure from its table with the current code; the sidecar then
     describes the new PNG, and the result is not taken for rewritten."""
     import shutil
     full = ROOT / "reports" / "full"
@@ -85,8 +119,9 @@ def test_redraw_records_the_new_figure(tmp_path: Path) -> None:
         pytest.skip("no committed full-mode results")
     for suffix in (".csv", ".png", provenance.SUFFIX):
         shutil.copy(full / f"support_radius{suffix}", tmp_path)
+    from studies.redraw import redraw
     before = provenance.status(tmp_path, "support_radius").state
-    png = provenance.redraw(tmp_path, "support_radius")
+    png = redraw(tmp_path, "support_radius")
     assert png.stat().st_size > 10_000
     assert provenance.status(tmp_path, "support_radius").state == before
 
