@@ -128,29 +128,37 @@ def _draw(ax, mesh: meshio.Mesh, vmax: float, title: str):
 
 
 def figure(df: pd.DataFrame) -> Figure:
-    """Snapshots of the paper-resolution run, the final surfaces and static regions against the experiment, and
+    """The initial configuration and snapshots of the paper-resolution run (cf. Fig. 27), the final surfaces and static regions against the experiment, and
     run-out and wall height against the node count (cf. Fig. 28)."""
     import matplotlib.pyplot as plt
 
     ok = df[df.status == "ok"]
     ended = ok.at_rest.astype(bool) | (ok.end_time_s >= FINAL) if len(ok) else pd.Series(dtype=bool)
     surface, line = benchmarks.data(DATA, "final_surface"), benchmarks.data(DATA, "failure_line")
-    fig = plt.figure(figsize=(13, 8.5))
-    grid = fig.add_gridspec(3, 4, height_ratios=[1, 1, 1.6])
+    shown: list = []
     if len(ok):
         main = ok.iloc[min(1, len(ok) - 1)]          # the paper's 1071 nodes in full mode
         states = read_pvd(Path(main.folder) / "result.pvd")
         final_t, final = state_at(Path(main.folder))
         vmax = float(np.nanmax(final.point_data["displacement"]))
-        shown = [min(states, key=lambda s: abs(s[0] - t)) for t in SNAPSHOTS if t <= final_t] + [states[-1]]
-        for k, (t, f) in enumerate(shown[:4]):
-            ax = fig.add_subplot(grid[k // 2, 2 * (k % 2):2 * (k % 2) + 2])
-            last = k == len(shown) - 1
-            label = f"{main.grid}: t = {t:.2f} s" + ((" (final)" if ended.iloc[min(1, len(ok) - 1)] else
-                                                      " (mid-flow: the run stops here)") if last else "")
-            sc = _draw(ax, meshio.read(f), vmax, label)
-        fig.colorbar(sc, ax=fig.axes, shrink=0.5, label="displacement (m)", location="right")
-    ax = fig.add_subplot(grid[2, :3])
+        shown = [states[0]] + [min(states, key=lambda s: abs(s[0] - t)) for t in SNAPSHOTS if t <= final_t]
+        shown = list(dict.fromkeys(shown + [states[-1]]))[:5]   # (a) the initial state, ..., the last one once
+    rows = (len(shown) + 1) // 2
+    fig = plt.figure(figsize=(13, 2.3 * rows + 4.5), layout="constrained")
+    grid = fig.add_gridspec(rows + 1, 4, height_ratios=[1] * rows + [2.0])
+    snapshots = []
+    for k, (t, f) in enumerate(shown):
+        ax = fig.add_subplot(grid[k // 2, 2 * (k % 2):2 * (k % 2) + 2])
+        what = ("initial configuration (gate removed)" if k == 0 else
+                ("final configuration" if ended.iloc[min(1, len(ok) - 1)] else "mid-flow: the run stops here, not final")
+                if k == len(shown) - 1 else "")
+        label = f"({'abcde'[k]}) {main.grid}: t = {t:.2f} s" + (f", {what}" if what else "")
+        sc = _draw(ax, meshio.read(f), vmax, label)
+        snapshots.append(ax)
+    if snapshots:
+        fig.colorbar(sc, ax=snapshots, shrink=0.8, label="displacement magnitude (m)", location="right")
+    spare = len(shown) % 2 == 1              # an odd number of snapshots leaves a slot: the node-count panel there
+    ax = fig.add_subplot(grid[rows, :] if spare else grid[rows, :3])
     ax.plot(surface[:, 0], surface[:, 1], "ko", ms=4, label="experiment: final surface")
     ax.plot(line[:, 0], line[:, 1], "ks", mfc="none", ms=4, label="experiment: failure line")
     ax.plot([0, 0.2, 0.2], [0.1, 0.1, 0], "k:", lw=0.8, label="initial column")
@@ -167,13 +175,13 @@ def figure(df: pd.DataFrame) -> Figure:
     ax.set(xlabel="x (m)", ylabel="y (m)", xlim=(0, 0.5), ylim=(0, 0.11), aspect="equal", title=title)
     ax.legend(fontsize=6, loc="upper right")
     ax.grid(True, alpha=0.3)
-    ax = fig.add_subplot(grid[2, 3])
+    ax = fig.add_subplot(grid[rows - 1, 2:] if spare else grid[rows, 3])
     if len(ok):
         ax.plot(ok.nodes, ok.run_out_m, "o-", label="run-out (m)")
         ax.plot(ok.nodes, ok.height_at_wall_m, "s-", label="height at the wall (m)")
         ax.axhline(ok.run_out_measured_m.iloc[0], color="C0", ls=":", label="experiment")
         ax.axhline(0.1, color="C1", ls=":")
-    ax.set(xlabel="field nodes", ylabel="length (m)", title="against node count")
+    ax.set(xlabel="number of field nodes (-)", ylabel="length (m)", title="against node count")
     ax.legend(fontsize=7)
     ax.grid(True, alpha=0.3)
     return fig
