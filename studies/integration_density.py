@@ -34,7 +34,7 @@ def specs(quick: bool) -> list[CaseSpec]:
 
 def figure(df: pd.DataFrame) -> Figure:
     """Tip and energy-norm errors against d_c/r, the paper's satisfactory range shaded (cf. Fig. 10)."""
-    return error_plot(df, PARAMETER, "d_c / r", TITLE, PAPER_RANGE)
+    return error_plot(df, PARAMETER, "integration density d_c / r, r = r_x = r_y (-)", TITLE, PAPER_RANGE)
 
 
 if __name__ == "__main__":

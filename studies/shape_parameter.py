@@ -33,7 +33,7 @@ def specs(quick: bool) -> list[CaseSpec]:
 
 def figure(df: pd.DataFrame) -> Figure:
     """Tip and energy-norm errors against eta, the paper's low and stable range shaded (cf. Fig. 12)."""
-    return error_plot(df, PARAMETER, "eta", TITLE, PAPER_RANGE)
+    return error_plot(df, PARAMETER, "shape parameter eta (-)", TITLE, PAPER_RANGE)
 
 
 if __name__ == "__main__":

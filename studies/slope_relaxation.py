@@ -56,15 +56,17 @@ def figure(df: pd.DataFrame) -> Figure:
         colour = cmap(srfs.index(r.srf) / max(len(srfs) - 1, 1))
         ax.plot([p[0] for p in h], [p[1] for p in h], "-", color=colour,
                 label=f"SRF {r.srf:g} ({'at rest' if r.stable else 'moving'})")
-    ax.set(xlabel="step", ylabel="maximum displacement (m)", title="CTM-RPIM (cf. Fig. 19a)", yscale="log")
+    ax.set(xlabel="dynamic-relaxation step (-)", ylabel="maximum displacement (m)",
+           title="CTM-RPIM: maximum displacement at every step (cf. Fig. 19a)", yscale="log")
     ax = axes[0, 1]
     for method, colour in (("ctm-rpim", "tab:blue"), ("fem-p2", "tab:orange")):
         d = ok[ok.method == method]
         ax.plot(d.srf, d.max_displacement, "-o", color=colour, label=method)
         f = d[~d.stable.astype(bool)]
         ax.plot(f.srf, f.max_displacement, "kx", ms=9)
-    ax.plot([], [], "kx", label="not at rest after 3000 steps")
-    ax.set(xlabel="SRF", ylabel="final maximum displacement (m)", title="cf. Fig. 19b", yscale="log")
+    ax.plot([], [], "kx", label=f"not at rest after {int(ok.steps.max())} steps")
+    ax.set(xlabel="strength reduction factor SRF (-)", ylabel="final maximum displacement (m)",
+           title="Final maximum displacement against SRF (cf. Fig. 19b)", yscale="log")
     return finished(fig, axes, fontsize=7)
 
 

@@ -51,7 +51,7 @@ def figure(df: pd.DataFrame) -> Figure:
         ax.plot(f.srf, f.max_displacement, "x", ms=9, color=colour)
     ax.plot([], [], "ko", label="stable (converged)")
     ax.plot([], [], "kx", label="failed (last iterate)")
-    ax.set(xlabel="SRF", ylabel="maximum displacement (m)", yscale="log", title=TITLE)
+    ax.set(xlabel="strength reduction factor SRF (-)", ylabel="maximum displacement (m)", yscale="log", title=TITLE)
     return finished(fig, axes)
 
 

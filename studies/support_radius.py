@@ -34,7 +34,7 @@ def specs(quick: bool) -> list[CaseSpec]:
 
 def figure(df: pd.DataFrame) -> Figure:
     """Tip and energy-norm errors against r_c/d_c, the paper's recommended range shaded (cf. Fig. 11)."""
-    return error_plot(df, PARAMETER, "r_c / d_c", TITLE, PAPER_RANGE)
+    return error_plot(df, PARAMETER, "support radius r_c / d_c (-)", TITLE, PAPER_RANGE)
 
 
 if __name__ == "__main__":
