@@ -66,14 +66,25 @@ def specs(quick: bool) -> list[CaseSpec]:
 
 def extra(summary: dict) -> dict:
     """The factor-of-safety bracket, Bishop's, their worst relative difference, the levels and iterations, what
-    decided the failure, the tangent and the cap."""
+    decided the failure, the tangent and the cap, and how far the displacement had run away when the search
+    stopped: the largest growth of a stable level (its displacement from the stable level below per relative SRF
+    rise, over the displacement at SRF = 1) against the runaway limit ``limit_growth``, and the displacement at the
+    last stable level over the one at SRF = 1. A bracket decided by non-convergence far below the runaway limit
+    is the iteration's, not the slope's."""
     fos = summary["factor_of_safety"]
     target = summary["parameters"]["problem"]["name"]
     reference = bishop(target)
     worst = max(abs(fos["stable"] / reference - 1), abs(fos["failed"] / reference - 1))
+    stable = [h for h in summary.get("history", []) if h.get("stable")]
+    growth = max((h["growth"] for h in stable if h.get("growth") is not None), default=float("nan"))
+    first = min(stable, key=lambda h: h["srf"]) if stable else None
+    last = max(stable, key=lambda h: h["srf"]) if stable else None
     return {"fs_stable": fos["stable"], "fs_failed": fos["failed"], "bishop": reference,
             "worst_rel_diff": worst, "levels": summary["counts"]["levels"],
             "iterations": summary["counts"]["newton_iterations"], "decided_by": fos.get("decided_by"),
+            "largest_stable_growth": growth, "limit_growth": fos.get("limit_growth"),
+            "displacement_ratio_at_stable": (last["max_displacement"] / first["max_displacement"]
+                                             if first and first["max_displacement"] else float("nan")),
             "tangent": summary["parameters"]["loading"]["tangent"],
             "max_iterations": summary["parameters"]["loading"]["max_iterations"]}
 
