@@ -17,7 +17,7 @@ import studies
 from ctmrpim.io.atomic import atomic_write_text
 from studies import explicit_conservation
 from studies.integration_schemes import scheme_table
-from studies.report import dynamics, large_deformation, linear, models, stability, summary
+from studies.report import dynamics, full_figures, large_deformation, linear, models, stability, summary
 from studies.report.checks import all_checks, claims_table, console_summary
 from studies.report.fe_references import write_fe_references
 from studies.report.markdown import Progress
@@ -53,10 +53,10 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     large_deformation.write_end_moment(w, tables["end_moment"], out_dir if quick else None)
     large_deformation.write_deformed_shapes(w, quick, out_dir, progress)
     stability.write_side_by_side(w, tables["slope_stability"], tables["footing_bearing"])
-    stability.write_slope_stability(w, tables["slope_stability"])
+    stability.write_slope_stability(w, tables["slope_stability"], out_dir if quick else None)
     stability.write_srf_sweep(w, tables["slope_srf_sweep"])
     stability.write_relaxation(w, tables["slope_relaxation"])
-    stability.write_footing(w, tables["footing_bearing"])
+    stability.write_footing(w, tables["footing_bearing"], out_dir if quick else None)
     stability.write_stability_fields(w, quick, out_dir, progress)
     stability.write_slope_slide(w, tables["slope_slide"])
     dynamics.write_column_collapse(w, tables["column_collapse"], quick)
@@ -68,6 +68,8 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     dynamics.write_collapse_settings(w, tables["column_collapse_settings"])
     dynamics.write_collapse_viscosity(w, tables["column_collapse_viscosity"])
     dynamics.write_full_mode_notes(w, out_dir)
+    if quick:
+        full_figures.write_full_figures(w, out_dir)
     write_nonlinear_schemes(w, tables["nonlinear_schemes"])
     path = out_dir / "REPORT.md"
     atomic_write_text(path, buf.getvalue())

@@ -23,6 +23,49 @@ def _finest(df: pd.DataFrame, method: str) -> pd.Series | None:
     return None if d.empty else d.sort_values("nodes").iloc[-1]
 
 
+def full_mode(out_dir: Path | None, name: str, table: pd.DataFrame) -> tuple[pd.DataFrame | None, str]:
+    """The full-mode table of study ``name`` to quote: the committed one under ``out_dir/full`` with its provenance
+    state in a quick report (``out_dir`` given), ``table`` itself in a full one (``out_dir`` None)."""
+    if out_dir is None:
+        return table, "this run"
+    from studies.report.large_deformation import full_table
+    full, state = full_table(out_dir, name)
+    return full, f"`reports/full/{name}.csv`, {state}"
+
+
+def bracket_change(base: pd.Series, other: pd.Series, lo: str, hi: str) -> float:
+    """The largest relative change of a bracket [``lo``, ``hi``] from row ``base`` to row ``other``."""
+    return max(abs(other[lo] / base[lo] - 1), abs(other[hi] / base[hi] - 1))
+
+
+def slope_refinement(full: pd.DataFrame) -> pd.DataFrame:
+    """One row per slope, method and cloud of the full run (default variant): the factor-of-safety bracket, what
+    decided it and how far the displacement had run away by then (the largest growth of a stable level against
+    the runaway limit)."""
+    ok = full[(full.status == "ok") & (full.variant.fillna("default") == "default")]
+    rows = [{"slope": r.slope, "method": r.method, "h (m)": r.h, "nodes": int(r.nodes),
+             "bracket": f"[{r.fs_stable:.4f}, {r.fs_failed:.4f}]",
+             "vs Bishop": span([100 * (r.fs_stable / r.bishop - 1), 100 * (r.fs_failed / r.bishop - 1)], "+.2f")
+             + " %", "decided by": r.decided_by,
+             "largest growth / limit": f"{r.largest_stable_growth:.3g} / {r.limit_growth:g}",
+             "time_s": f"{r.time_s:.0f}"}
+            for _, r in ok.sort_values(["slope", "method", "h"], ascending=[True, True, False]).iterrows()]
+    return pd.DataFrame(rows)
+
+
+def variant_changes(full: pd.DataFrame, keys: list[str], base: str, lo: str, hi: str) -> pd.DataFrame:
+    """The relative change of each variant's bracket from the ``base`` variant's at the same ``keys`` (the
+    full run's sensitivities: tangent, cap, domain): one row per variant and case."""
+    ok = full[full.status == "ok"]
+    rows = []
+    for _, r in ok[ok.variant != base].iterrows():
+        same = ok[(ok.variant == base) & np.logical_and.reduce([ok[k] == r[k] for k in keys])]
+        if len(same):
+            rows.append({**{k: r[k] for k in keys}, "variant": r.variant,
+                         "change": bracket_change(same.iloc[0], r, lo, hi)})
+    return pd.DataFrame(rows)
+
+
 def stability_side_by_side(slopes: pd.DataFrame, footing: pd.DataFrame) -> pd.DataFrame:
     """One row per stability benchmark: the paper's value, ours, scikit-fem P2's, the analytical one (the
     published values from the tolerances table, Bishop's from the study's own search)."""
@@ -76,8 +119,9 @@ def k0_yield_depth(name: str = "slope") -> tuple[float, float]:
     return k0, 2 * m["c"] * math.cos(phi) / (gamma * ((1 - k0) - (1 + k0) * math.sin(phi)))
 
 
-def write_slope_stability(w: Writer, sl: pd.DataFrame) -> None:
-    """The slopes' factor of safety by strength reduction (Figs. 18-20), every number from ``sl``."""
+def write_slope_stability(w: Writer, sl: pd.DataFrame, out_dir: Path | None = None) -> None:
+    """The slopes' factor of safety by strength reduction (Figs. 18-20), every number from ``sl`` and, in a quick
+    report, from the committed full-mode table under ``out_dir``."""
     w("## Stability: slope by strength reduction (cf. Figs. 18-20)\n\n")
     w(f"{studies.study('slope_stability').__doc__.strip()}\n\n")
     cols = ["slope", "method", "nodes", "fs_stable", "fs_failed", "bishop", "worst_rel_diff", "levels", "iterations",
@@ -108,10 +152,13 @@ def write_slope_stability(w: Writer, sl: pd.DataFrame) -> None:
           f"({', '.join(f'{b:.3f}' for b in bishops)}), {'inside' if inside else 'outside'} the paper's "
           f"[{paper[0]:g}, {paper[1]:g}] and {'below' if hi < gl_fe else 'not below'} Griffiths & Lane's "
           f"finite-element {gl_fe:g}. ")
-    full = sorted(set(ok.slope))
-    w(f"The default clouds ({', '.join(f'`{n}`' for n in full)} at their benchmark spacing) run in full mode "
-      "only, and no full-mode table of this study is committed (`reports/full/slope_stability.csv`), so their "
-      "brackets are not quoted here. ")
+    full, state = full_mode(out_dir, "slope_stability", sl)
+    if full is None or "variant" not in full:
+        w(f"The default clouds ({', '.join(f'`{n}`' for n in sorted(set(ok.slope)))} at their benchmark spacing) "
+          "run in full mode only, and no full-mode table of this study is committed "
+          "(`reports/full/slope_stability.csv`), so their brackets are not quoted here. ")
+    else:
+        write_slope_full(w, full, state)
     k0, depth = k0_yield_depth()
     decided = (", ".join(f"{n} of {len(ok)} by {k}" for k, n in ok.decided_by.value_counts().items())
                if "decided_by" in ok and ok.decided_by.notna().any() else "")
@@ -125,6 +172,54 @@ def write_slope_stability(w: Writer, sl: pd.DataFrame) -> None:
       "weight); there full Newton wanders for tens of iterations, so the slopes iterate on the elastic stiffness "
       "(factorised once for the whole search) with Anderson-mixed steps (`loading.tangent = \"elastic\"`, see "
       "`ctmrpim/solvers/plastic_system.py`).\n\n")
+
+
+def write_slope_full(w: Writer, full: pd.DataFrame, state: str) -> None:
+    """The full run's slopes on three clouds each, what decided each bracket, the sensitivities to the tangent
+    and the cap, and the vertical cut against Taylor (issue 19, item 6): where the gap to Bishop comes from."""
+    w(f"\n\n**Full mode** ({state}): each slope on three clouds, both methods on the same nodes; the largest "
+      "growth is the largest displacement growth of a stable level (its displacement from the stable level "
+      "below per relative SRF rise, over the displacement at SRF = 1) against the runaway limit:\n\n")
+    w(md(slope_refinement(full)) + "\n\n")
+    ok = full[(full.status == "ok") & (full.variant.fillna("default") == "default")]
+    slopes = ok[ok.slope.isin(("slope", "slope-gl"))]
+    finest = slopes.sort_values("h").groupby(["slope", "method"]).head(1)
+    coarsest = slopes.sort_values("h").groupby(["slope", "method"]).tail(1)
+    if len(finest):
+        by_nc = finest[finest.decided_by == "non-convergence"]
+        w(f"From the coarsest to the finest cloud the stable end of the bracket falls by "
+          f"{span(100 * (1 - finest.set_index(['slope', 'method']).fs_stable / coarsest.set_index(['slope', 'method']).fs_stable), '.1f')} % "
+          f"(both methods, both slopes), to {span(100 * (finest.fs_stable / finest.bishop - 1), '+.1f')} % from "
+          "Bishop's simplified method. ")
+        if len(by_nc):
+            w(f"On the finest clouds {len(by_nc)} of {len(finest)} brackets are decided by non-convergence (the "
+              "equilibrium iteration fails even with twice its cap) while the displacement has grown at most "
+              f"{by_nc.largest_stable_growth.max():.2g} times (the runaway limit is "
+              f"{by_nc.limit_growth.max():g}): there the iteration stopped before the slope ran away, so those "
+              "brackets' stable ends are lower bounds of the discrete factor of safety (an equilibrium was found "
+              "there), not its value, and no extrapolation to h = 0 is drawn from them. ")
+    changes = variant_changes(full, ["slope", "method"], "default", "fs_stable", "fs_failed")
+    moved = changes[changes.slope.isin(("slope", "slope-gl"))] if len(changes) else changes
+    for variant, d in moved.groupby("variant") if len(moved) else ():
+        w(f"On the benchmarks' own clouds variant `{variant}` moves the bracket by {span(100 * d.change, '.2f')} % "
+          "(both methods, both slopes). ")
+    gl_fe = tolerances.entry("published-slope-gl-fs")["values"][0]
+    own = full[(full.status == "ok") & full.slope.isin(("slope", "slope-gl"))]
+    if len(own):
+        best = own.loc[own.fs_stable.idxmax()]
+        w(f"The highest stable level any run reached is {best.fs_stable:.4f} ({best.slope}, {best.method}, h = "
+          f"{best.h:g} m, variant {best.variant}), {100 * (best.fs_stable / best.bishop - 1):+.1f} % from Bishop; "
+          f"Griffiths & Lane's finite-element {gl_fe:g} for `slope-gl` lies "
+          f"{100 * (gl_fe / own[own.slope == 'slope-gl'].fs_failed.max() - 1):+.1f} % above the highest failed "
+          "level of ours. ")
+    cut = ok[ok.slope == "vertical-cut"].sort_values("h")
+    if len(cut):
+        taylor = tolerances.entry("vertical-cut-fem-p2-fs")["reference"]
+        w(f"The vertical cut ({taylor}): " + "; ".join(
+            f"{m} " + ", ".join(f"h = {r.h:g} m [{r.fs_stable:.4f}, {r.fs_failed:.4f}] ({r.decided_by})"
+                                for _, r in d.iterrows())
+            for m, d in cut.groupby("method")) + ". ")
+    w("\n\n")
 
 
 def k0_nu(name: str = "slope") -> float:
@@ -177,9 +272,9 @@ def write_relaxation(w: Writer, rx: pd.DataFrame) -> None:
       "\"dynamic-relaxation\"`) is not part of this study: its bracket is not quoted.\n\n")
 
 
-def write_footing(w: Writer, fo: pd.DataFrame) -> None:
-    """The strip footing's limit pressure against Prandtl (Figs. 22-25), every number from ``fo`` and the published
-    values of the tolerances table."""
+def write_footing(w: Writer, fo: pd.DataFrame, out_dir: Path | None = None) -> None:
+    """The strip footing's limit pressure against Prandtl (Figs. 22-25), every number from ``fo``, the committed
+    full-mode table under ``out_dir`` (quick report) and the published values of the tolerances table."""
     w("## Stability: strip footing (cf. Figs. 22-25)\n\n")
     w(f"{studies.study('footing_bearing').__doc__.strip()}\n\n")
     w(md(pct(fo[[c for c in ("grid", "method", "nodes", "limit_carried_kPa", "limit_failed_kPa", "worst_rel_diff",
@@ -224,9 +319,43 @@ def write_footing(w: Writer, fo: pd.DataFrame) -> None:
           f"{paper['limit_kPa'][0]:g} kPa lies "
           f"{'above' if ok.limit_failed_kPa.max() < paper['limit_kPa'][0] else 'not above'} every computed limit. "
           "The centre's settlement over B is a serviceability reading, not the failure criterion. ")
-    w("The full run's coarser (37 x 16) and finer (73 x 31) grids, where an earlier run showed the nearly "
-      "isochoric plastic flow locking CTM-RPIM's coarse cloud, are not committed as a table "
-      "(`reports/full/footing_bearing.csv`), so they are not quoted.\n\n")
+    full, state = full_mode(out_dir, "footing_bearing", fo)
+    if full is None or "benchmark" not in full:
+        w("The full run's coarser and finer grids of the undrained footing and the frictional footings are not "
+          "committed as a table (`reports/full/footing_bearing.csv`), so they are not quoted.\n\n")
+    else:
+        write_footing_full(w, full, state)
+
+
+def write_footing_full(w: Writer, full: pd.DataFrame, state: str) -> None:
+    """The full run's footings: the undrained one on three grids, the frictional ones on three clouds against
+    c N_c, and the sensitivities to the tangent, the cap and the domain (issue 19, items 3 and 4)."""
+    ok = full[full.status == "ok"]
+    base = ok[ok.variant.fillna("consistent") == "consistent"]
+    rows = [{"benchmark": r.benchmark, "method": r.method, "grid": r.grid, "nodes": int(r.nodes),
+             "limit (kPa)": f"[{r.limit_carried_kPa:.2f}, {r.limit_failed_kPa:.2f}]",
+             "reference (kPa)": f"{r.reference_kPa:.2f}",
+             "difference": span([100 * (r.limit_carried_kPa / r.reference_kPa - 1),
+                                 100 * (r.limit_failed_kPa / r.reference_kPa - 1)], "+.2f") + " %",
+             "decided by": r.decided_by, "time_s": f"{r.time_s:.0f}"}
+            for _, r in base.sort_values(["benchmark", "method", "nodes"]).iterrows()]
+    w(f"\n\n**Full mode** ({state}): every footing on three clouds, against Prandtl's (2 + pi) c_u and "
+      "Prandtl-Reissner's c N_c (weightless soil):\n\n" + md(pd.DataFrame(rows)) + "\n\n")
+    fr = base[base.benchmark != "footing"]
+    if len(fr):
+        finest = fr.sort_values("nodes").groupby(["benchmark", "method"]).tail(1)
+        diff = 100 * (finest.limit_carried_kPa / finest.reference_kPa - 1)
+        falling = [d.sort_values("nodes").limit_carried_kPa.is_monotonic_decreasing
+                   for _, d in fr.groupby(["benchmark", "method"])]
+        w(f"On the finest clouds the frictional limits (carried) lie {span(diff, '+.2f')} % from c N_c (both "
+          f"methods, {', '.join(sorted(set(finest.benchmark)))}); the limit falls with every refinement in "
+          f"{sum(falling)} of {len(falling)} series. ")
+    changes = variant_changes(full, ["benchmark", "method", "grid"], "consistent", "limit_carried_kPa",
+                              "limit_failed_kPa")
+    for variant, d in changes.groupby("variant") if len(changes) else ():
+        w(f"Variant `{variant}` moves the limit by {span(100 * d.change, '.3f')} % ({len(d)} cases: "
+          + ", ".join(f"{r.benchmark} {r.method} {r.grid}" for _, r in d.iterrows()) + "). ")
+    w("\n\n")
 
 
 def write_stability_fields(w: Writer, quick: bool, out_dir: Path, progress: Progress) -> None:

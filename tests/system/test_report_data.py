@@ -59,7 +59,7 @@ def render(reports: Path = REPORTS) -> tuple[str, set[str]]:
     ``reports`` (the figure sections that run their own cases: their docstrings); the text and the headings of
     the sections that could not be rendered because a table is missing."""
     from studies.integration_schemes import scheme_table
-    from studies.report import dynamics, large_deformation, linear, stability, summary
+    from studies.report import dynamics, full_figures, large_deformation, linear, stability, summary
     from studies.report.checks import all_checks, claims_table
     from studies.report.fe_references import write_fe_references
     from studies.report.nonlinear_schemes import write_nonlinear_schemes
@@ -109,13 +109,13 @@ def render(reports: Path = REPORTS) -> tuple[str, set[str]]:
             ("slope_stability", "footing_bearing"),
             lambda: stability.write_side_by_side(w, t("slope_stability"), t("footing_bearing")))
     section("Stability: slope by strength reduction (cf. Figs. 18-20)", ("slope_stability",),
-            lambda: stability.write_slope_stability(w, t("slope_stability")))
+            lambda: stability.write_slope_stability(w, t("slope_stability"), reports))
     section("Displacement against SRF (cf. Fig. 19b)", ("slope_srf_sweep",),
             lambda: stability.write_srf_sweep(w, t("slope_srf_sweep")))
     section("Dynamic relaxation (cf. Fig. 19a)", ("slope_relaxation",),
             lambda: stability.write_relaxation(w, t("slope_relaxation")))
     section("Stability: strip footing (cf. Figs. 22-25)", ("footing_bearing",),
-            lambda: stability.write_footing(w, t("footing_bearing")))
+            lambda: stability.write_footing(w, t("footing_bearing"), reports))
     w(f"### Fields (cf. Figs. 20 and 25)\n\n{stability_fields.__doc__.strip()}\n\n")
     section("The slide at SRF = 1.6 (cf. Fig. 21)", ("slope_slide",),
             lambda: stability.write_slope_slide(w, t("slope_slide")))
@@ -131,6 +131,7 @@ def render(reports: Path = REPORTS) -> tuple[str, set[str]]:
     section("Viscosity", ("column_collapse_viscosity",),
             lambda: dynamics.write_collapse_viscosity(w, t("column_collapse_viscosity")))
     dynamics.write_full_mode_notes(w, reports)
+    full_figures.write_full_figures(w, reports)
     section("Integration schemes on the nonlinear benchmarks (not in the paper)", ("nonlinear_schemes",),
             lambda: write_nonlinear_schemes(w, t("nonlinear_schemes")))
     return buf.getvalue(), missing
