@@ -41,9 +41,18 @@ B = 4.0
 #: the sensitivity variants: overrides of the benchmark's [loading]
 VARIANTS = {"consistent": (), "elastic": ('loading.tangent="elastic"', "loading.max_iterations=100"),
             "cap x2": ("loading.max_iterations=30",)}
-#: the frictional footings' domains enlarged by half in both directions (W x D: 16 x 7 -> 24 x 10.5 m at
-#: phi = 20 deg, 24 x 10 -> 36 x 15 m at phi = 30 deg), at h = B / 8: the limit must not move by 0.5 %
-ENLARGED = {"footing-phi20": (24.0, 10.5), "footing-phi30": (36.0, 15.0)}
+#: the frictional footings' domains enlarged by this factor in both directions (the benchmarks' W and D), at
+#: h = B / 8: the limit must not move by 0.5 %
+ENLARGEMENT = 1.5
+
+
+def _enlarged(target: str) -> tuple[float, float]:
+    """The width and depth (m) of benchmark ``target``'s domain enlarged by :data:`ENLARGEMENT`."""
+    import tomllib
+
+    from ctmrpim import benchmarks
+    p = tomllib.loads(benchmarks.path(target).read_text())["parameters"]
+    return ENLARGEMENT * p["W"], ENLARGEMENT * p["D"]
 METHODS = ("ctm-rpim", "fem")
 
 
@@ -67,11 +76,11 @@ def specs(quick: bool) -> list[CaseSpec]:
                 for h in SPACINGS for solver in METHODS]
         out += [_spec(target, (f"parameters.h={SPACINGS[-1]!r}",), solver, f"h = B / {B / SPACINGS[-1]:g}", variant)
                 for variant in ("elastic", "cap x2") for solver in METHODS]
-        W, D = ENLARGED[target]
+        W, D = _enlarged(target)
         out += [CaseSpec(target, (f"parameters.h={SPACINGS[0]!r}", f"parameters.W={W!r}", f"parameters.D={D!r}"),
                          solver, element_for(solver, "p2"),
                          labels=(("benchmark", target), ("grid", f"h = B / {B / SPACINGS[0]:g}"),
-                                 ("variant", "domain x1.5")))
+                                 ("variant", f"domain x{ENLARGEMENT:g}")))
                 for solver in METHODS]
     return out
 
@@ -157,10 +166,17 @@ def figure(df: pd.DataFrame) -> Figure:
         shown.append(np.array(c["w_m"]) * 100)
         ax.plot(c["q_kPa"], shown[-1], styles[r.method], marker=".", ms=3,
                 label=f"{r.method}, {r.grid}: limit {r.limit_carried_kPa:.1f}-{r.limit_failed_kPa:.1f} kPa")
-    ax.axvline(PRANDTL, color="k", lw=0.8, label="Prandtl (2 + pi) c_u = 514.2 kPa")
-    ax.plot([500], [5.1], "ks", mfc="none", label="Smith & Griffiths: 5.1 cm at 500 kPa")
-    ax.plot([500], [6.0], "k^", mfc="none", label="paper: about 6 cm at 500 kPa")
-    _settlement_axis(ax, [*shown, np.array([5.1, 6.0])])
+    ax.axvline(PRANDTL, color="k", lw=0.8, label=f"Prandtl (2 + pi) c_u = {PRANDTL:.1f} kPa")
+    from studies import tolerances  # here: drawing reads the published points, computing needs none
+
+    published = []
+    for key, marker, name in (("published-footing-smith-griffiths", "ks", "Smith & Griffiths"),
+                              ("published-footing-paper", "k^", "paper: about")):
+        e = tolerances.entry(key)
+        published.append(100 * e["settlement_m"])
+        ax.plot([e["pressure_kPa"]], [published[-1]], marker, mfc="none",
+                label=f"{name} {published[-1]:g} cm at {e['pressure_kPa']:g} kPa")
+    _settlement_axis(ax, [*shown, np.array(published)])
     ax.set(xlabel="bearing pressure (kPa)", ylabel="settlement of the footing centre (cm)",
            title="Strip footing: settlement against pressure (cf. Fig. 24)")
     ax.set_xlim(left=0)

@@ -66,7 +66,8 @@ def _package_files(root: Path, package: str) -> list[str]:
 
 
 def _study_modules(root: Path, name: str) -> list[str]:
-    """``studies/NAME.py`` and the ``studies`` modules it imports, transitively (statically, from the source)."""
+    """``studies/NAME.py`` and the ``studies`` modules it imports, transitively (statically, from the source without
+    its case listing and drawing, :func:`_without_cases_and_drawing`)."""
     seen: set[str] = set()
     todo = [f"studies.{name}"]
     while todo:
@@ -77,7 +78,7 @@ def _study_modules(root: Path, name: str) -> list[str]:
         if not path.is_file():
             continue
         seen.add(mod)
-        tree = ast.parse(path.read_text())
+        tree = ast.parse(_without_cases_and_drawing(path.read_text()))   # what drawing imports computes nothing
         for node in ast.walk(tree):
             if isinstance(node, ast.ImportFrom):
                 base = node.module or ""

@@ -193,9 +193,9 @@ def write_slope_full(w: Writer, full: pd.DataFrame, state: str) -> None:
           "Bishop's simplified method. ")
         if len(by_nc):
             w(f"On the finest clouds {len(by_nc)} of {len(finest)} brackets are decided by non-convergence (the "
-              "equilibrium iteration fails even with twice its cap) while the displacement has grown at most "
-              f"{by_nc.largest_stable_growth.max():.2g} times (the runaway limit is "
-              f"{by_nc.limit_growth.max():g}): there the iteration stopped before the slope ran away, so those "
+              "equilibrium iteration fails even with twice its cap) while the displacement's growth has reached at "
+              f"most {(by_nc.largest_stable_growth / by_nc.limit_growth).max():.0%} of the runaway limit "
+              "(`strength-reduction.limit_growth`): there the iteration stopped before the slope ran away, so those "
               "brackets' stable ends are lower bounds of the discrete factor of safety (an equilibrium was found "
               "there), not its value, and no extrapolation to h = 0 is drawn from them. ")
     changes = variant_changes(full, ["slope", "method"], "default", "fs_stable", "fs_failed")
@@ -214,8 +214,8 @@ def write_slope_full(w: Writer, full: pd.DataFrame, state: str) -> None:
           "level of ours. ")
     cut = ok[ok.slope == "vertical-cut"].sort_values("h")
     if len(cut):
-        taylor = tolerances.entry("vertical-cut-fem-p2-fs")["reference"]
-        w(f"The vertical cut ({taylor}): " + "; ".join(
+        taylor = tolerances.entry("published-taylor-vertical-cut")["value"]
+        w(f"The vertical cut (Taylor's stability number: FS = {taylor:.4f}): " + "; ".join(
             f"{m} " + ", ".join(f"h = {r.h:g} m [{r.fs_stable:.4f}, {r.fs_failed:.4f}] ({r.decided_by})"
                                 for _, r in d.iterrows())
             for m, d in cut.groupby("method")) + ". ")
