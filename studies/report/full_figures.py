@@ -24,6 +24,10 @@ FIGURES = (
     ("slope_srf_sweep", "Fig. 19b: the slope's maximum displacement against the SRF (strength reduction)"),
     ("slope_relaxation", "Fig. 19a and 19b: the slope's maximum displacement at every dynamic-relaxation step for "
                          "each SRF of the full run, and its final value against the SRF"),
+    ("slope_stability", "Figs. 18-19: the factor-of-safety brackets of both slopes and the vertical cut on three "
+                        "clouds each, against Bishop"),
+    ("footing_bearing", "Fig. 24: the footing's settlement against the pressure, the undrained footing on three "
+                        "grids and the frictional ones on three clouds"),
 )
 
 
