@@ -26,6 +26,7 @@ FIGURES = (
                          "each SRF of the full run, and its final value against the SRF"),
     ("slope_stability", "Figs. 18-19: the factor-of-safety brackets of both slopes and the vertical cut on three "
                         "clouds each, against Bishop"),
+    ("slope_slide", "Fig. 21: the slope at SRF = 1.6 sliding, on the paper's cloud over the benchmark's duration"),
     ("footing_bearing", "Fig. 24: the footing's settlement against the pressure, the undrained footing on three "
                         "grids and the frictional ones on three clouds"),
 )

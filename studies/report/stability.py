@@ -355,6 +355,13 @@ def write_footing_full(w: Writer, full: pd.DataFrame, state: str) -> None:
     for variant, d in changes.groupby("variant") if len(changes) else ():
         w(f"Variant `{variant}` moves the limit by {span(100 * d.change, '.3f')} % ({len(d)} cases: "
           + ", ".join(f"{r.benchmark} {r.method} {r.grid}" for _, r in d.iterrows()) + "). ")
+        worst = d.loc[d.change.idxmax()]
+        row = ok[(ok.variant == variant) & (ok.benchmark == worst.benchmark) & (ok.method == worst.method)
+                 & (ok.grid == worst.grid)].iloc[0]
+        if worst.change > 0 and row.decided_by != "settlement runaway":
+            w(f"Its largest ({worst.benchmark}, {worst.method}, {worst.grid}) is decided by {row.decided_by} while "
+              f"the pressure still rises with the settlement at {row.slope_ratio_at_carried:.2f} of the elastic "
+              f"slope (the runaway limit is {row.limit_slope:g}): the iteration's limit, not the soil's. ")
     w("\n\n")
 
 
