@@ -139,10 +139,20 @@ def _without_cases_and_drawing(text: str) -> str:
 
 def _digest(path: Path, study_module: bool) -> str:
     """sha256 (16 hex digits) of one numerics source: :func:`file_digest`, a study module without its case
-    listing and drawing."""
-    if study_module:
-        return _sha(normalised_source(_without_cases_and_drawing(path.read_text())).encode())[:16]
-    return file_digest(path)[:16]
+    listing and drawing. Normalised once per content in a process (the report asks for every study's state
+    several times, and every study shares the package's two hundred sources: parsing them is the cost)."""
+    data = path.read_bytes()
+    key = (_sha(data), path.suffix, study_module)
+    if key not in _DIGESTS:
+        if study_module:
+            _DIGESTS[key] = _sha(normalised_source(_without_cases_and_drawing(data.decode())).encode())[:16]
+        else:
+            _DIGESTS[key] = file_digest(path)[:16]
+    return _DIGESTS[key]
+
+
+#: :func:`_digest`'s results by (sha256 of the raw file, suffix, study module)
+_DIGESTS: dict[tuple[str, str, bool], str] = {}
 
 
 def _listed(specs: list, root: str) -> str:
