@@ -14,6 +14,7 @@ import studies
 from ctmrpim import benchmarks
 from studies import stability_fields, tolerances
 from studies.footing_bearing import PRANDTL
+from studies.report.large_deformation import full_table
 from studies.report.markdown import Progress, Writer, md, pct, span
 
 
@@ -28,7 +29,6 @@ def full_mode(out_dir: Path | None, name: str, table: pd.DataFrame) -> tuple[pd.
     state in a quick report (``out_dir`` given), ``table`` itself in a full one (``out_dir`` None)."""
     if out_dir is None:
         return table, "this run"
-    from studies.report.large_deformation import full_table
     full, state = full_table(out_dir, name)
     return full, f"`reports/full/{name}.csv`, {state}"
 
