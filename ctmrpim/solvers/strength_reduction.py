@@ -52,8 +52,8 @@ CRITERION = {"newton": "displacement runaway or non-convergence: a level is fail
                        "the SRF-displacement curve turning flat), or when the equilibrium iteration (loading.tangent: "
                        "Newton, or the elastic stiffness with Anderson mixing) does not reach the residual and "
                        "displacement tolerance at an SRF sub-step cut back loading.max_cutbacks times, re-checked before "
-                       "it counts for as long as its residual still halves every loading.max_iterations iterations "
-                       "(at most 8 times loading.max_iterations)",
+                       "it counts for as long as its residual falls fast enough to converge within 8 times "
+                       "loading.max_iterations",
              "dynamic-relaxation": "still moving: after dynamic.steps steps of dynamic relaxation the out-of-balance "
                                    "force is above dynamic.tolerance of the loads and the maximum displacement grew "
                                    "by more than 1 % over the last quarter of the steps (the paper's criterion: it "
