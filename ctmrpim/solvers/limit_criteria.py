@@ -25,7 +25,8 @@ class SettlementCriterion:
     the slope of the purely elastic body. Method-agnostic: it needs the forces and the elastic stiffness only.
     Converging Newton iterations along the plateau do not count as carried (the consistent tangent of perfect
     plasticity converges far along it: 38 m of settlement on the phi = 20 deg footing), nor does an iteration
-    cap that gives out before the knee count as failure without the re-check of twice the cap."""
+    cap that gives out before the knee count as failure without the re-check with more patience
+    (:func:`~ctmrpim.solvers.load_stepping.step_loads`)."""
 
     direction: np.ndarray          # F / sum |F| (2n,), zero at the fixed dofs
     elastic_slope: float           # load factor per unit settlement of the elastic body
@@ -57,7 +58,7 @@ class SettlementCriterion:
 
     def describe(self, peak_traction: float) -> dict[str, Any]:
         """The criterion as summary.json states it."""
-        return {"rule": "an increment is carried when it reaches equilibrium (a non-convergence re-checked with twice "
+        return {"rule": "an increment is carried when it reaches equilibrium (a non-convergence re-checked with 8 times "
                         "loading.max_iterations) and the slope of pressure against settlement from the last carried "
                         "level, dq/dw, is at least loading.limit_slope times the elastic body's; the settlement is "
                         "the load-weighted mean displacement along the load",

@@ -251,16 +251,19 @@ class PlasticSystem:
         increment converges, or is cut back as any other, by the load stepping's criteria. Counted in
         ``safeguarded_steps``."""
         self.safeguarded_steps += 1
-        K = self.elastic_stiffness()
+        du = np.zeros_like(residual)
+        du[self.free] = self._elastic_factors().solve(residual[self.free])
+        return du
+
+    def _elastic_factors(self):
+        """The factors of the constrained elastic stiffness, computed once (a singular one is a model error)."""
         if self._lu_elastic is None:
             try:
-                self._lu_elastic = self._factorise(K)
+                self._lu_elastic = self._factorise(self.elastic_stiffness())
             except RuntimeError as exc:
                 raise self._unconstrained(exc) from None
             self.factorisations += 1
-        du = np.zeros_like(residual)
-        du[self.free] = self._lu_elastic.solve(residual[self.free])
-        return du
+        return self._lu_elastic
 
     def iteration_counts(self) -> dict[str, Any]:
         """Tangents built, factorisations and the seconds spent in each phase of the iterations."""
@@ -294,15 +297,8 @@ class PlasticSystem:
 
     def elastic_response(self, F: np.ndarray) -> np.ndarray:
         """U (2n,) of the elastic stiffness under the forces F (2n,), zero at the fixed dofs."""
-        K = self.elastic_stiffness()
-        if self._lu_elastic is None:
-            try:
-                self._lu_elastic = self._factorise(K)
-            except RuntimeError as exc:
-                raise self._unconstrained(exc) from None
-            self.factorisations += 1
         U = np.zeros_like(F)
-        U[self.free] = self._lu_elastic.solve(F[self.free])
+        U[self.free] = self._elastic_factors().solve(F[self.free])
         return U
 
 

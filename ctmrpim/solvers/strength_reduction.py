@@ -52,7 +52,7 @@ CRITERION = {"newton": "displacement runaway or non-convergence: a level is fail
                        "the SRF-displacement curve turning flat), or when the equilibrium iteration (loading.tangent: "
                        "Newton, or the elastic stiffness with Anderson mixing) does not reach the residual and "
                        "displacement tolerance at an SRF sub-step cut back loading.max_cutbacks times, re-checked with "
-                       "twice loading.max_iterations before it counts",
+                       "8 times loading.max_iterations before it counts",
              "dynamic-relaxation": "still moving: after dynamic.steps steps of dynamic relaxation the out-of-balance "
                                    "force is above dynamic.tolerance of the loads and the maximum displacement grew "
                                    "by more than 1 % over the last quarter of the steps (the paper's criterion: it "
