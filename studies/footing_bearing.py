@@ -2,7 +2,7 @@
 raised in increments until the soil cannot carry it; the limit pressure is the bracket [last carried, first not
 carried], read from the load-settlement curve: an increment whose slope of pressure against settlement from the
 last carried level falls below `loading.limit_slope` (1 %) of the elastic body's is not carried, though Newton may
-converge there, and a non-convergence counts only after a re-check with twice the iteration cap. Against Prandtl's
+converge there, and a non-convergence counts only after a re-check (Newton on the consistent tangent, 8 times its cap). Against Prandtl's
 (2 + pi) c_u for the undrained footing (phi = psi ~ 0) and Prandtl-Reissner's c N_c for the frictional ones
 (footing-phi20, footing-phi30). CTM-RPIM and scikit-fem P2 on the same node grids (the default 49 x 21 has the
 paper's node count), with the load-settlement curve of the footing centre, beside the published values of Smith &

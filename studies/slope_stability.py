@@ -4,7 +4,7 @@ the two candidate geometries of Fig. 18 - `slope` (Smith & Griffiths 6.4 embankm
 scikit-fem P2 on the same nodes with the same PlasticSystem, return mapping and search (bracket by
 0.1 from SRF = 1 continuing from the last stable state, then bisection to 0.01; a level fails when its
 displacement runs away - the largest displacement from the stable level below, per unit relative SRF rise, above
-`strength-reduction.limit_growth` times the largest at SRF = 1 - or when the equilibrium iteration does not converge even with twice its cap,
+`strength-reduction.limit_growth` times the largest at SRF = 1 - or when the equilibrium iteration does not converge even on the re-check (Newton on the consistent tangent),
 see ctmrpim.solvers.strength_reduction), against Bishop's simplified method computed by us
 for each geometry (critical circle searched), and the published values (the side-by-side table above).
 Node spacing h: the default clouds (0.58 m for `slope`, close to the paper's node count; 0.35 m for
@@ -12,7 +12,8 @@ Node spacing h: the default clouds (0.58 m for `slope`, close to the paper's nod
 show the trend with resolution; quick mode runs the coarser ones only. The full run adds the vertical cut in undrained clay (against Taylor's
 stability number and our Bishop search) on three clouds and, on each benchmark's own cloud, the sensitivity of the
 factor of safety to the tangent (variant "consistent": Newton with its own cap) and to the iteration cap
-(variant "cap x2": the elastic-stiffness iteration's max_iterations doubled).
+(variant "cap x2": the elastic-stiffness iteration's max_iterations doubled), and both slopes on all three clouds
+with an associated flow rule (variant "associated": psi = phi), the flow rule's share of the gap to Bishop.
 """
 from __future__ import annotations
 
@@ -42,6 +43,15 @@ PAPER = (1.3, 1.4)
 #: the sensitivity variants (full run, each benchmark's own cloud): overrides of the benchmark's [loading]
 VARIANTS = {"default": (), "consistent": ('loading.tangent="consistent"', "loading.max_iterations=15"),
             "cap x2": ("loading.max_iterations=200",)}
+#: the frictional slopes run associated as well (psi = phi) on all three clouds: the flow rule's share of the gap to
+#: Bishop's simplified method, a rigid-plastic limit equilibrium that knows no dilatancy (full run)
+ASSOCIATED = ("slope", "slope-gl")
+
+
+def _associated(target: str) -> tuple[str, ...]:
+    """The override that makes benchmark ``target``'s flow associated: psi = its phi."""
+    import tomllib
+    return (f"material.psi={tomllib.loads(benchmarks.path(target).read_text())['material']['phi']!r}",)
 
 
 @cache
@@ -58,9 +68,12 @@ def specs(quick: bool) -> list[CaseSpec]:
     for target, hs in SPACING.items():
         for h in hs[mode]:
             variants = ("default",) if quick or h != OWN_SPACING[target] else tuple(VARIANTS)
-            out += [CaseSpec(target, (f"parameters.h={h!r}",) + VARIANTS[v], solver, element_for(solver, "p2"),
+            overrides = {v: VARIANTS[v] for v in variants}
+            if not quick and target in ASSOCIATED:
+                overrides["associated"] = _associated(target)
+            out += [CaseSpec(target, (f"parameters.h={h!r}",) + extra, solver, element_for(solver, "p2"),
                              labels=(("slope", target), ("h", h), ("variant", v)))
-                    for v in variants for solver in ("ctm-rpim", "fem")]
+                    for v, extra in overrides.items() for solver in ("ctm-rpim", "fem")]
     return out
 
 

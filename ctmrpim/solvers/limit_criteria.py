@@ -58,8 +58,8 @@ class SettlementCriterion:
 
     def describe(self, peak_traction: float) -> dict[str, Any]:
         """The criterion as summary.json states it."""
-        return {"rule": "an increment is carried when it reaches equilibrium (a non-convergence re-checked with 8 times "
-                        "loading.max_iterations) and the slope of pressure against settlement from the last carried "
+        return {"rule": "an increment is carried when it reaches equilibrium (a non-convergence re-checked by Newton on "
+                        "the consistent tangent with 8 times its cap) and the slope of pressure against settlement from the last carried "
                         "level, dq/dw, is at least loading.limit_slope times the elastic body's; the settlement is "
                         "the load-weighted mean displacement along the load",
                 "limit_slope": self.fraction, "elastic_slope": self.elastic_slope * peak_traction,

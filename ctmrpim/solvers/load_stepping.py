@@ -28,15 +28,18 @@ not on the count of cut-backs: an increment fails for good when its step is at m
 the last carried increment was longer than ``ROLLBACK`` such steps, its end may already lie past the
 criterion (a long step's secant averages the steep and the flat part of the curve), so the path goes back
 to its start (``restore(snapshot())`` of the state there) and takes it again in halves, the step never
-growing back beyond them. ``recheck``: an increment still not converged when the cut-backs are spent is tried
-once more with ``RECHECK_LIMIT`` times ``max_iterations`` before its non-convergence counts (then judged like
-any converged one); the history says so. Why so many: the elastic-stiffness iteration with Anderson mixing
-converges linearly at a rate that worsens as the cloud is refined, and its residual is not monotone (it may
-rise tenfold for a hundred iterations before it falls), so neither twice the cap nor a rate read from the
-residual tells a slow iteration from a failing body (measured: the slope at h = 0.42 m, FE P2, failed at SRF
-1.30 with the cap 100 re-checked at 200; a re-check stopped when the residual's rate of fall would not reach
-the tolerance failed the same way; re-checked at 800 its sub-steps converged in 121-695 iterations, the
-residual rising from 4e-4 to 3.6e-3 on the way, and the level was stable).
+growing back beyond them.
+
+``recheck``: an increment still not converged when the cut-backs are spent is tried once more before its
+non-convergence counts (then judged like any converged one); the history says so. An iteration on a fixed
+matrix (``recheck_assemble`` given: the elastic stiffness with Anderson mixing) is re-checked by Newton on the
+consistent tangent, up to ``RECHECK_LIMIT`` x ``NEWTON_ITERATIONS`` iterations; Newton's own iteration with
+``RECHECK_LIMIT`` x ``max_iterations``. Why not more of the same patience: the elastic-stiffness iteration
+converges linearly at a rate that worsens as the cloud is refined and as the body nears collapse, and its
+residual is not monotone, so where it gives up depends on how long it is allowed to go on (measured: the slope,
+psi = 0, at h = 0.42 m, FE P2, failed at SRF 1.30 with the cap 100 re-checked at 200, at [1.3266, 1.3328] re-checked
+at 800 and at [1.3344, 1.3406] with the cap 400), while Newton either converges in a few iterations or runs away
+(the same slope by Newton throughout: [1.3361, 1.3377], the failed level's iterate diverging).
 """
 from __future__ import annotations
 
@@ -60,6 +63,10 @@ DIVERGENCE = 100.0
 ROLLBACK = 4
 #: The re-check of a non-converged increment takes this many times ``max_iterations`` (see the module doc).
 RECHECK_LIMIT = 8
+#: Newton's iterations per increment that the re-check of an iteration on a fixed matrix counts as its
+#: ``max_iterations`` (the benchmarks' cap for the consistent tangent: it converges in 3-10 where there is an
+#: equilibrium, and runs away where there is none).
+NEWTON_ITERATIONS = 15
 
 
 class Anderson:
@@ -117,7 +124,9 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
                stop_on_failure: bool = False, anderson: int = 0,
                judge: Callable[[float, np.ndarray, float, np.ndarray], tuple[str | None, dict]] | None = None,
                recheck: bool = False, snapshot: Callable[[], Any] | None = None,
-               restore: Callable[[Any], None] | None = None) -> LoadPath:
+               restore: Callable[[Any], None] | None = None,
+               recheck_assemble: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, sp.spmatrix]] | None = None
+               ) -> LoadPath:
     """Apply the load in increments of the load factor from 0 up to 1.
 
     ``assemble(U, factor)`` returns (F_ext, F_int, K) at the trial state (a ProblemError there, e.g.
@@ -133,7 +142,9 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
     fixed-point map U -> U + K^-1 r(U), restarted whenever ``assemble`` returns a new K): perfect
     plasticity needs it, see :class:`Anderson`.
 
-    ``judge``, ``recheck``, ``snapshot`` and ``restore``: the response criterion of a limit load (module doc).
+    ``judge``, ``recheck``, ``snapshot`` and ``restore``: the response criterion of a limit load (module doc);
+    ``recheck_assemble``, where given, is the ``assemble`` of the re-check: Newton's consistent tangent for an
+    iteration on a fixed matrix.
     """
     steps, tolerance = loading.steps, loading.tolerance
     path = LoadPath(U=np.zeros(n_dofs) if U0 is None else U0.copy())
@@ -149,11 +160,13 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
             return path.cutbacks >= loading.max_cutbacks
         return dfactor <= min_step * (1 + 1e-9)
 
-    def newton(target: float, cap: int) -> tuple[np.ndarray, bool, int]:
-        start = path.U.copy()
-        if last_step is not None:
-            start += (target - factor) / last_dfactor * last_step
-        start[fixed] = start_values + target * (fixed_values - start_values)
+    def newton(target: float, cap: int, assemble: Callable = assemble, start: np.ndarray | None = None
+               ) -> tuple[np.ndarray, bool, int]:
+        if start is None:
+            start = path.U.copy()
+            if last_step is not None:
+                start += (target - factor) / last_dfactor * last_step
+            start[fixed] = start_values + target * (fixed_values - start_values)
         status = lambda it, r: report.status(_iteration_status(   # noqa: E731
             converged_increments, factor, dfactor, target, it, r, path.cutbacks))
         return _newton(path, start, target, cap, fixed, tolerance, assemble, solve, anderson, status)
@@ -163,10 +176,15 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
         trial, converged, it = newton(target, loading.max_iterations)
         verdict, note, judged = None, "", {}
         if not converged and recheck and exhausted():
-            cap = RECHECK_LIMIT * loading.max_iterations   # a symptom: check it with more patience
-            trial, converged, it = newton(target, cap)
-            note = (f"converged only on the re-check ({it} iterations)" if converged else
-                    f"no convergence with {RECHECK_LIMIT} x max_iterations ({cap}) either")
+            # a symptom: check it with more patience, and with Newton where the iteration was on a fixed matrix
+            cap = RECHECK_LIMIT * (loading.max_iterations if recheck_assemble is None else NEWTON_ITERATIONS)
+            # Newton goes on from the fixed-matrix iteration's last iterate, where that is finite (nearer to an
+            # equilibrium than the predictor: Newton from the predictor diverges where it does not from there)
+            start = trial if recheck_assemble is not None and np.all(np.isfinite(trial)) else None
+            trial, converged, it = newton(target, cap, recheck_assemble or assemble, start)
+            how = "" if recheck_assemble is None else "Newton on the consistent tangent, "
+            note = (f"converged only on the re-check ({how}{it} iterations)" if converged else
+                    f"no convergence on the re-check ({how}{cap} iterations) either")
         if converged and judge is not None:
             verdict, judged = judge(factor, path.U, target, trial)
         if not converged or verdict is not None:

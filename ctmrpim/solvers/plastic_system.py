@@ -163,10 +163,10 @@ class PlasticSystem:
         """Make a :meth:`snapshot` the committed state again."""
         self.U, self.stress, self.region, self.plastic_strain = (a.copy() for a in state)
 
-    def assemble(self, material: MohrCoulomb, U: np.ndarray, load_factor: float
+    def assemble(self, material: MohrCoulomb, U: np.ndarray, load_factor: float, matrix: str | None = None
                  ) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix]:
         """(F_ext (2n,), F_int (2n,), K (2n x 2n)) at the trial U (2n,); K is the elastic stiffness or the
-        consistent tangent."""
+        consistent tangent, as ``matrix`` says (default: the system's ``tangent``)."""
         with self.clock.measure("return mapping"):
             de = self.strain_increment(U)
             stress, region = material.update(self.stress, de)
@@ -175,10 +175,10 @@ class PlasticSystem:
             f_int = self._internal(stress)
         with self.clock.measure("tangent"):
             self.elastic_stiffness()
-            if self.tangent == "elastic":
+            if (matrix or self.tangent) == "elastic":
                 if self._K is None:
-                    self._K = self._K_elastic
                     self.tangents += 1
+                self._K = self._K_elastic
             else:
                 # K = K_elastic + the plastic points' correction: its product runs over those points only
                 plastic = np.flatnonzero(region != ELASTIC)
@@ -201,19 +201,24 @@ class PlasticSystem:
         The safeguard: a consistent tangent that SuperLU finds exactly singular, or whose step is not finite,
         is replaced for this iteration by the elastic stiffness (:meth:`_safeguarded`); only a singular
         elastic stiffness is bad input (constraints that leave a rigid-body motion free)."""
+        if K is self._K_elastic:          # factorised once, also between the re-check's Newton tangents
+            with self.clock.measure("factorisation"):
+                factors = self._elastic_factors()
+            with self.clock.measure("substitution"):
+                du = np.zeros_like(residual)
+                du[self.free] = factors.solve(residual[self.free])
+            return du
         with self.clock.measure("factorisation"):
             if self._lu is None or self._lu[0] is not K:
                 try:
                     self._lu = (K, self._factorise(K))
-                except RuntimeError as exc:
-                    if K is self._K_elastic:
-                        raise self._unconstrained(exc) from None
+                except RuntimeError:
                     return self._safeguarded(residual)
                 self.factorisations += 1
         with self.clock.measure("substitution"):
             du = np.zeros_like(residual)
             du[self.free] = self._lu[1].solve(residual[self.free])
-        if K is not self._K_elastic and not np.all(np.isfinite(du)):
+        if not np.all(np.isfinite(du)):
             return self._safeguarded(residual)
         return du
 
@@ -286,6 +291,9 @@ class PlasticSystem:
         def assemble(U: np.ndarray, t: float):
             return self.assemble(material_at(t), U, load_at(t))
 
+        def assemble_consistent(U: np.ndarray, t: float):
+            return self.assemble(material_at(t), U, load_at(t), "consistent")
+
         def converged(t: float, U: np.ndarray) -> dict[str, Any]:
             self.commit(material_at(t), U)
             return on_converged(t, U)
@@ -293,7 +301,8 @@ class PlasticSystem:
         return step_loads(len(self.U), loading, self.fixed,
                           self.fixed_values if fixed_values is None else fixed_values, assemble, self.solve,
                           converged, U0=self.U, stop_on_failure=stop_on_failure, anderson=ANDERSON,
-                          judge=judge, recheck=recheck, snapshot=self.snapshot, restore=self.restore)
+                          judge=judge, recheck=recheck, snapshot=self.snapshot, restore=self.restore,
+                          recheck_assemble=assemble_consistent if self.tangent == "elastic" else None)
 
     def elastic_response(self, F: np.ndarray) -> np.ndarray:
         """U (2n,) of the elastic stiffness under the forces F (2n,), zero at the fixed dofs."""

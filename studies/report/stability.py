@@ -164,7 +164,7 @@ def write_slope_stability(w: Writer, sl: pd.DataFrame, out_dir: Path | None = No
                if "decided_by" in ok and ok.decided_by.notna().any() else "")
     w("A level fails when its displacement runs away (the largest displacement from the stable level below, per "
       "relative rise of the SRF, above `strength-reduction.limit_growth` times the largest at SRF = 1) or when the "
-      "equilibrium iteration does not converge even with twice the benchmark's cap (`[loading]`): "
+      "equilibrium iteration does not converge even on the re-check by Newton on the consistent tangent: "
       "non-convergence alone is only a symptom" + (f"; in this run's brackets {decided}" if decided else "") +
       ". The gravity stage yields a wide zone at "
       f"depth (with nu = {k0_nu():g} the elastic K0 = {k0:.2f} state lies on the Mohr-Coulomb edge sigma_xx = "
@@ -193,7 +193,7 @@ def write_slope_full(w: Writer, full: pd.DataFrame, state: str) -> None:
           "Bishop's simplified method. ")
         if len(by_nc):
             w(f"On the finest clouds {len(by_nc)} of {len(finest)} brackets are decided by non-convergence (the "
-              "equilibrium iteration fails even with twice its cap) while the displacement's growth has reached at "
+              "equilibrium iteration fails even on the re-check) while the displacement's growth has reached at "
               f"most {(by_nc.largest_stable_growth / by_nc.limit_growth).max():.0%} of the runaway limit "
               "(`strength-reduction.limit_growth`): there the iteration stopped before the slope ran away, so those "
               "brackets' stable ends are lower bounds of the discrete factor of safety (an equilibrium was found "
@@ -308,7 +308,7 @@ def write_footing(w: Writer, fo: pd.DataFrame, out_dir: Path | None = None) -> N
         w(f"A level counts as carried while it is in equilibrium and its pressure still rises with the settlement at "
           f"least {ok.limit_slope.iloc[0]:.0%} as steeply as the elastic body's (`loading.limit_slope`; the "
           "settlement is the load-weighted mean under the footing); a non-convergence counts only after a re-check "
-          "with twice the iteration cap. Small-strain perfect plasticity lets Newton converge far along the "
+          "(Newton on the consistent tangent with 8 times its cap). Small-strain perfect plasticity lets Newton converge far along the "
           "plateau, so the last converged level is not the limit: the limit is where the curve turns flat. At the "
           "carried limit " + "; ".join(
               f"{r.method} ({r.grid}) has settled {100 * r.settlement_at_carried_m:.1f} cm (mean) and its centre "

@@ -1,22 +1,23 @@
 """The re-check of a non-converged increment (issue 19, item 2): non-convergence is a symptom, so an iteration that
-still makes progress is given the time it needs, and one whose residual stalls is not waited for."""
+still makes progress is given the time it needs, an iteration on a fixed matrix is checked by Newton, and a body
+without an equilibrium fails all the same."""
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
 
 from ctmrpim.problem.settings import Loading
-from ctmrpim.solvers.load_stepping import RECHECK_LIMIT, step_loads
+from ctmrpim.solvers.load_stepping import NEWTON_ITERATIONS, RECHECK_LIMIT, step_loads
 
 
-def _run(kappa: float, recheck: bool = True):
+def _run(kappa: float, recheck: bool = True, newton=None):
     """One dof with f_int = u under f_ext = t, iterated with the 'stiffness' kappa: the error contracts by
     1 - 1 / kappa per iteration (a linear rate, as the elastic-stiffness iteration's near a limit)."""
     K = sp.csr_matrix([[kappa]])
     loading = Loading(steps=1, tolerance=1e-6, max_iterations=100, max_cutbacks=0)
     return step_loads(1, loading, np.array([], int), np.array([]),
                       lambda U, t: (np.array([t]), U.copy(), K), lambda K, r: r / K[0, 0],
-                      lambda t, U: {}, stop_on_failure=True, recheck=recheck)
+                      lambda t, U: {}, stop_on_failure=True, recheck=recheck, recheck_assemble=newton)
 
 
 def test_a_slow_but_steady_iteration_converges_on_the_recheck() -> None:
@@ -35,5 +36,30 @@ def test_a_failing_iteration_fails_after_the_recheck() -> None:
     path = _run(1e5)
     assert path.failed_at == 1.0
     last = path.history[-1]
-    assert f"no convergence with {RECHECK_LIMIT} x max_iterations" in last["note"]
+    assert f"no convergence on the re-check ({RECHECK_LIMIT * 100} iterations)" in last["note"]
     assert last["iterations"] == RECHECK_LIMIT * 100
+
+
+def test_an_iteration_on_a_fixed_matrix_is_rechecked_by_newton() -> None:
+    """The fixed 'stiffness' 1e5 cannot converge within the re-check's patience, but the equilibrium exists: Newton
+    on the true tangent (1) finds it in two iterations, and the history says which iteration carried it."""
+    exact = sp.csr_matrix([[1.0]])
+    path = _run(1e5, newton=lambda U, t: (np.array([t]), U.copy(), exact))
+    assert path.failed_at is None and np.isclose(path.U[0], 1.0, rtol=1e-9)
+    last = path.history[-1]
+    assert "Newton on the consistent tangent" in last["note"] and last["iterations"] <= 2
+
+
+def test_newton_recheck_fails_a_body_without_equilibrium() -> None:
+    """f_int = tanh(u) cannot carry f_ext = 1.5: Newton's re-check runs away (or reaches its cap) and the increment
+    fails after at most RECHECK_LIMIT x NEWTON_ITERATIONS iterations."""
+    def assemble(U, t):
+        return np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[1.0 / np.cosh(np.clip(U[0], -50, 50)) ** 2 + 1e-12]])
+    loading = Loading(steps=1, tolerance=1e-6, max_iterations=100, max_cutbacks=0)
+    path = step_loads(1, loading, np.array([], int), np.array([]),
+                      lambda U, t: (np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[2.0]])),
+                      lambda K, r: r / K[0, 0], lambda t, U: {}, stop_on_failure=True, recheck=True,
+                      recheck_assemble=assemble)
+    assert path.failed_at == 1.0
+    assert path.history[-1]["iterations"] <= RECHECK_LIMIT * NEWTON_ITERATIONS
+    assert "no convergence on the re-check (Newton" in path.history[-1]["note"]
