@@ -106,16 +106,24 @@ def figure(df: pd.DataFrame) -> Figure:
     """The factor-of-safety bracket of every case against Bishop's and the paper's range (cf. Figs. 18-19)."""
     fig, axes = new_figure(1, 6.5)
     ax = axes[0, 0]
-    ok = df[(df.status == "ok") & (df.get("variant", "default") == "default")].reset_index(drop=True)
+    variant = df["variant"] if "variant" in df else pd.Series("default", index=df.index)
+    ok = df[(df.status == "ok") & (variant == "default")].reset_index(drop=True)
+    associated = df[(df.status == "ok") & (variant == "associated")]
     labels = []
     for i, r in ok.iterrows():
         colour = "tab:blue" if r.method == "ctm-rpim" else "tab:orange"
         ax.plot([i, i], [r.fs_stable, r.fs_failed], "-", lw=6, color=colour, solid_capstyle="butt")
         ax.plot([i - 0.35, i + 0.35], [r.bishop, r.bishop], "k-", lw=1)
+        same = associated[(associated.slope == r.slope) & (associated.method == r.method) & (associated.h == r.h)]
+        for _, a in same.iterrows():
+            ax.plot([i + 0.25, i + 0.25], [a.fs_stable, a.fs_failed], "-", lw=3, color="tab:green",
+                    solid_capstyle="butt")
         labels.append(f"{r.slope}\n{r.method}\n{r.nodes} nodes")
     ax.axhspan(*PAPER, color="0.9", label="paper: stable at 1.3, failed at 1.4")
     ax.plot([], [], "-", lw=6, color="tab:blue", label="CTM-RPIM [stable, failed]")
     ax.plot([], [], "-", lw=6, color="tab:orange", label="scikit-fem P2 [stable, failed]")
+    if len(associated):
+        ax.plot([], [], "-", lw=3, color="tab:green", label="the same, associated flow (psi = phi)")
     ax.plot([], [], "k-", label="Bishop's simplified method (ours)")
     ax.set_xticks(range(len(labels)), labels, fontsize=7)
     ax.set(xlabel="benchmark, method and node count", ylabel="factor of safety (SRF)", title=TITLE,

@@ -16,6 +16,7 @@ from studies import column_collapse, provenance, tolerances
 from studies.column_collapse import FINAL, FRONT_STOPPED
 from studies.column_collapse_settings import EARLY, early_differences
 from studies.report.checks import collapse_checks
+from studies.report.full_results import full_rows
 from studies.report.markdown import Writer, each, md, sci, span
 
 COLLAPSE_COLUMNS = ["grid", "nodes", "end_time_s", "at_rest", "run_out_m", "height_at_wall_m", "surface_max_dev_m",
@@ -131,16 +132,6 @@ def write_collapse_viscosity(w: Writer, vs: pd.DataFrame) -> None:
                          "surface_max_dev_m", "surface_mean_dev_m", "failure_line_mean_dist_m", "slope_deg",
                          "viscous_share", "steps", "time_s", "status"] if c in vs]]))
     w("\n\n![column collapse viscosity](column_collapse_viscosity.png)\n\n")
-
-
-def read_full(out_dir: Path, name: str) -> pd.DataFrame | None:
-    """The committed full-mode table of study ``name`` (``out_dir/full/NAME.csv``), its rows that ran; None if
-    absent."""
-    f = Path(out_dir) / "full" / f"{name}.csv"
-    if not f.is_file():
-        return None
-    df = pd.read_csv(f)
-    return df[df.status == "ok"].reset_index(drop=True)
 
 
 def missed_targets(df: pd.DataFrame) -> dict[int, list[str]]:
@@ -292,7 +283,7 @@ def write_full_mode_notes(w: Writer, out_dir: Path) -> None:
     """What the full runs measured, read from the committed full-mode tables under ``out_dir/full``, with their
     figures."""
     w("### Full mode (measured)\n\n")
-    cc, vs, st = (read_full(out_dir, n) for n in FULL_STUDIES)
+    cc, vs, st = (full_rows(out_dir, n) for n in FULL_STUDIES)
     w("Read from the full-mode tables committed under `reports/full/` (`ctmrpim study column-collapse --out "
       "reports/full`, the same for `column-collapse-viscosity` and `column-collapse-settings`).\n\n")
     if cc is None and vs is None and st is None:

@@ -12,19 +12,10 @@ import pandas as pd
 import studies
 from ctmrpim import benchmarks
 from ctmrpim.reference.elastica import tip_load_elliptic
-from studies import deformed_shapes, provenance, tolerances
+from studies import deformed_shapes, tolerances
 from studies.fe_references import converged_table, converged_tip_load
+from studies.report.full_results import full_table
 from studies.report.markdown import Progress, Writer, md, sci, span
-
-
-def full_table(out_dir: Path | None, name: str) -> tuple[pd.DataFrame | None, str]:
-    """The committed full-mode table of study ``name`` under ``out_dir/full`` (None where there is none) and its
-    provenance state in words (a stale one is quoted as flagged, :mod:`studies.provenance`)."""
-    full = Path(out_dir) / "full" if out_dir is not None else None
-    if full is None or not (full / f"{name}.csv").is_file():
-        return None, ""
-    state = provenance.status(full, name)
-    return pd.read_csv(full / f"{name}.csv"), (state.state if state.usable else f"**{state.state}**")
 
 
 def write_tip_load(w: Writer, tip: pd.DataFrame, fe: pd.DataFrame | None = None,
