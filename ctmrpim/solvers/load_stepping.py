@@ -127,25 +127,15 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
                restore: Callable[[Any], None] | None = None,
                recheck_assemble: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, sp.spmatrix]] | None = None
                ) -> LoadPath:
-    """Apply the load in increments of the load factor from 0 up to 1.
+    """Apply the load in increments of the load factor from 0 up to 1 (cut-backs, the response criterion
+    ``judge`` with ``snapshot`` and ``restore``, the ``recheck`` and its ``recheck_assemble``: the module doc).
 
-    ``assemble(U, factor)`` returns (F_ext, F_int, K) at the trial state (a ProblemError there, e.g.
-    an inverted material, cuts the increment back); ``solve(K, r)`` returns du with du = 0 at the
-    fixed dofs; ``on_converged(factor, U)`` returns the extra history entries of a converged increment
-    (probe values) and may record the state. The path starts from ``U0`` (default zero) and the
-    prescribed displacements go linearly from their values in U0 to ``fixed_values``. When the
-    increment cannot be cut back any further the solve raises a ConvergenceError with the history so
-    far, or with ``stop_on_failure`` returns the path so far with ``failed_at`` set (a limit load, a
-    failed strength-reduction level).
-
-    ``anderson = m > 0`` mixes each Newton step with the last m (Anderson acceleration of the
-    fixed-point map U -> U + K^-1 r(U), restarted whenever ``assemble`` returns a new K): perfect
-    plasticity needs it, see :class:`Anderson`.
-
-    ``judge``, ``recheck``, ``snapshot`` and ``restore``: the response criterion of a limit load (module doc);
-    ``recheck_assemble``, where given, is the ``assemble`` of the re-check: Newton's consistent tangent for an
-    iteration on a fixed matrix.
-    """
+    ``assemble(U, factor)`` returns (F_ext, F_int, K) at the trial state (a ProblemError there, e.g. an inverted
+    material, cuts the increment back); ``solve(K, r)`` du with du = 0 at the fixed dofs; ``on_converged(factor,
+    U)`` the extra history entries of a converged increment (it may record the state). The path starts from ``U0``
+    (default zero), the prescribed displacements going linearly from their values there to ``fixed_values``. With
+    no cut-back left the solve raises a ConvergenceError with the history so far, or with ``stop_on_failure``
+    returns the path so far with ``failed_at`` set. ``anderson = m > 0``: :class:`Anderson` mixing of depth m."""
     steps, tolerance = loading.steps, loading.tolerance
     path = LoadPath(U=np.zeros(n_dofs) if U0 is None else U0.copy())
     start_values = path.U[fixed].copy()
@@ -176,10 +166,8 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
         trial, converged, it = newton(target, loading.max_iterations)
         verdict, note, judged = None, "", {}
         if not converged and recheck and exhausted():
-            # a symptom: check it with more patience, and with Newton where the iteration was on a fixed matrix
+            # a symptom: re-checked, by Newton from the fixed-matrix iteration's last iterate where there was one
             cap = RECHECK_LIMIT * (loading.max_iterations if recheck_assemble is None else NEWTON_ITERATIONS)
-            # Newton goes on from the fixed-matrix iteration's last iterate, where that is finite (nearer to an
-            # equilibrium than the predictor: Newton from the predictor diverges where it does not from there)
             start = trial if recheck_assemble is not None and np.all(np.isfinite(trial)) else None
             trial, converged, it = newton(target, cap, recheck_assemble or assemble, start)
             how = "" if recheck_assemble is None else "Newton on the consistent tangent, "
