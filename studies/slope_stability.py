@@ -103,31 +103,31 @@ def extra(summary: dict) -> dict:
 
 
 def figure(df: pd.DataFrame) -> Figure:
-    """The factor-of-safety bracket of every case against Bishop's and the paper's range (cf. Figs. 18-19)."""
-    fig, axes = new_figure(1, 6.5)
-    ax = axes[0, 0]
+    """The factor-of-safety bracket of every case against its node count, one panel per benchmark: both methods with
+    the benchmark's flow rule and (full run) with an associated one, Bishop's simplified method and the paper's range
+    (cf. Figs. 18-19)."""
     variant = df["variant"] if "variant" in df else pd.Series("default", index=df.index)
-    ok = df[(df.status == "ok") & (variant == "default")].reset_index(drop=True)
-    associated = df[(df.status == "ok") & (variant == "associated")]
-    labels = []
-    for i, r in ok.iterrows():
-        colour = "tab:blue" if r.method == "ctm-rpim" else "tab:orange"
-        ax.plot([i, i], [r.fs_stable, r.fs_failed], "-", lw=6, color=colour, solid_capstyle="butt")
-        ax.plot([i - 0.35, i + 0.35], [r.bishop, r.bishop], "k-", lw=1)
-        same = associated[(associated.slope == r.slope) & (associated.method == r.method) & (associated.h == r.h)]
-        for _, a in same.iterrows():
-            ax.plot([i + 0.25, i + 0.25], [a.fs_stable, a.fs_failed], "-", lw=3, color="tab:green",
-                    solid_capstyle="butt")
-        labels.append(f"{r.slope}\n{r.method}\n{r.nodes} nodes")
-    ax.axhspan(*PAPER, color="0.9", label="paper: stable at 1.3, failed at 1.4")
-    ax.plot([], [], "-", lw=6, color="tab:blue", label="CTM-RPIM [stable, failed]")
-    ax.plot([], [], "-", lw=6, color="tab:orange", label="scikit-fem P2 [stable, failed]")
-    if len(associated):
-        ax.plot([], [], "-", lw=3, color="tab:green", label="the same, associated flow (psi = phi)")
-    ax.plot([], [], "k-", label="Bishop's simplified method (ours)")
-    ax.set_xticks(range(len(labels)), labels, fontsize=7)
-    ax.set(xlabel="benchmark, method and node count", ylabel="factor of safety (SRF)", title=TITLE,
-           ylim=(1.25, 1.65))
+    ok = df[(df.status == "ok") & variant.isin(("default", "associated"))].assign(variant=variant)
+    slopes = list(dict.fromkeys(ok.slope))
+    fig, axes = new_figure(max(len(slopes), 1), 4.2)
+    styles = {("ctm-rpim", "default"): ("tab:blue", -0.04, "CTM-RPIM, psi as the benchmark's"),
+              ("fem-p2", "default"): ("tab:orange", -0.015, "scikit-fem P2, psi as the benchmark's"),
+              ("ctm-rpim", "associated"): ("tab:green", 0.015, "CTM-RPIM, associated (psi = phi)"),
+              ("fem-p2", "associated"): ("tab:olive", 0.04, "scikit-fem P2, associated (psi = phi)")}
+    for ax, slope in zip(axes[0], slopes):
+        d = ok[ok.slope == slope]
+        for (method, v), (colour, shift, label) in styles.items():
+            e = d[(d.method == method) & (d.variant == v)].sort_values("nodes")
+            if len(e):
+                x = e.nodes * 10 ** shift
+                ax.vlines(x, e.fs_stable, e.fs_failed, color=colour, lw=5, label=label)
+                ax.plot(x, 0.5 * (e.fs_stable + e.fs_failed), ":", color=colour, lw=1)
+        ax.axhline(d.bishop.iloc[0], color="k", lw=1, label="Bishop's simplified method (ours)")
+        if slope != "vertical-cut":
+            ax.axhspan(*PAPER, color="0.92", label="paper: stable at 1.3, failed at 1.4", zorder=0)
+        ax.set(xscale="log", xlabel="nodes", ylabel="factor of safety (SRF)", title=f"`{slope}`")
+    axes[0, 0].legend(fontsize=7, loc="upper right")
+    fig.suptitle(TITLE)
     return finished(fig, axes)
 
 
