@@ -278,7 +278,7 @@ def write_flow_rule(w: Writer, full: pd.DataFrame) -> None:
           f"three clouds the non-associated stable end falls by {span(fall, '.1f')} % from h = "
           f"{coarse['h (m)'].iloc[0]:g} m to h = {fine['h (m)'].iloc[0]:g} m, so a coarser discretisation gives a "
           "higher non-associated factor, and theirs (a coarse mesh of eight-node quadrilaterals with reduced "
-          "integration, failure read as non-convergence within 1000 iterations) is expected above ours; by how "
+          "integration, failure read as non-convergence) is expected above ours; by how "
           "much we cannot compute without their mesh. ")
 
 
