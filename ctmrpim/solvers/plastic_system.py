@@ -25,7 +25,9 @@ scikit-fem reference use the same one, with the same material class and the same
   not change with the strength reduction), each step Anderson-mixed with the last ones
   (:class:`ctmrpim.solvers.load_stepping.Anderson`). Measured on the 1928-node slope under gravity (16
   increments, tolerance 1e-4): 171 iterations in 8.9 s, against 57 consistent-tangent iterations with 30
-  tangents in 25.4 s.
+  tangents in 25.4 s. Where it gives up near a limit (a strength-reduction level, a limit load), the increment is
+  re-checked by Newton on the consistent tangent from its last iterate before the failure counts
+  (:func:`ctmrpim.solvers.load_stepping.step_loads`, ``recheck_assemble``).
 """
 from __future__ import annotations
 
