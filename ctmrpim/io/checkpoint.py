@@ -13,6 +13,7 @@ number is stored as ``{"float": "inf"}`` (or ``"-inf"``, ``"nan"``) and turned b
 """
 from __future__ import annotations
 
+import io
 import json
 import math
 from pathlib import Path
@@ -59,8 +60,12 @@ def save_checkpoint(folder: Path, key: str, meta: dict[str, Any], arrays: dict[s
     payload["meta"] = np.array(json.dumps(_encode(to_jsonable({**meta, "key": key})), allow_nan=False))
 
     def write(tmp: Path) -> None:
-        with open(tmp, "wb") as fh:          # a file object: np.savez would append ".npz" to a path
-            np.savez(fh, **payload)
+        # the archive is built in memory: a signal inside np.savez would otherwise leave its ZipFile open on a
+        # file the ``with`` has closed, and the ZipFile's finaliser prints a traceback at exit
+        buffer = io.BytesIO()
+        np.savez(buffer, **payload)
+        with open(tmp, "wb") as fh:
+            fh.write(buffer.getbuffer())
 
     atomic_write(path, write)
     return path

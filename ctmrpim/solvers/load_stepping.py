@@ -117,6 +117,20 @@ class LoadPath:
     failed_trial: np.ndarray | None = None   # and the last Newton iterate there (the mechanism)
 
 
+@dataclass
+class _Walk:
+    """Where :func:`step_loads` is on the path: the carried load factor and the next step, the last converged
+    step (the secant predictor's), the longest step allowed, the carried level's predecessor (``before``: where
+    a roll-back returns to) and the increments converged so far."""
+    factor: float
+    dfactor: float
+    max_step: float
+    last_step: np.ndarray | None = None
+    last_dfactor: float = 0.0
+    before: tuple | None = None
+    converged: int = 0
+
+
 def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: np.ndarray,
                assemble: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, sp.spmatrix]],
                solve: Callable[[sp.spmatrix, np.ndarray], np.ndarray],
@@ -136,63 +150,46 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
     (default zero), the prescribed displacements going linearly from their values there to ``fixed_values``. With
     no cut-back left the solve raises a ConvergenceError with the history so far, or with ``stop_on_failure``
     returns the path so far with ``failed_at`` set. ``anderson = m > 0``: :class:`Anderson` mixing of depth m."""
-    steps, tolerance = loading.steps, loading.tolerance
     path = LoadPath(U=np.zeros(n_dofs) if U0 is None else U0.copy())
     start_values = path.U[fixed].copy()
-    factor, dfactor = 0.0, 1.0 / steps
-    last_step, last_dfactor = None, 0.0
-    report, converged_increments = progress.current(), 0
-    min_step = 1.0 / steps / 2 ** loading.max_cutbacks
-    max_step, before = 1.0 / steps, None
+    walk = _Walk(factor=0.0, dfactor=1.0 / loading.steps, max_step=1.0 / loading.steps)
+    report = progress.current()
+    min_step = 1.0 / loading.steps / 2 ** loading.max_cutbacks
 
     def exhausted() -> bool:
         if judge is None:
             return path.cutbacks >= loading.max_cutbacks
-        return dfactor <= min_step * (1 + 1e-9)
+        return walk.dfactor <= min_step * (1 + 1e-9)
 
     def newton(target: float, cap: int, assemble: Callable = assemble, start: np.ndarray | None = None
                ) -> tuple[np.ndarray, bool, int]:
         if start is None:
             start = path.U.copy()
-            if last_step is not None:
-                start += (target - factor) / last_dfactor * last_step
+            if walk.last_step is not None:
+                start += (target - walk.factor) / walk.last_dfactor * walk.last_step
             start[fixed] = start_values + target * (fixed_values - start_values)
         status = lambda it, r: report.status(_iteration_status(   # noqa: E731
-            converged_increments, factor, dfactor, target, it, r, path.cutbacks))
-        return _newton(path, start, target, cap, fixed, tolerance, assemble, solve, anderson, status)
+            walk.converged, walk.factor, walk.dfactor, target, it, r, path.cutbacks))
+        return _newton(path, start, target, cap, fixed, loading.tolerance, assemble, solve, anderson, status)
 
-    while factor < 1.0 - 1e-12:
-        target = min(1.0, factor + dfactor)
+    while walk.factor < 1.0 - 1e-12:
+        target = min(1.0, walk.factor + walk.dfactor)
         trial, converged, it = newton(target, loading.max_iterations)
         verdict, note, judged = None, "", {}
         if not converged and recheck and exhausted():
-            # a symptom: re-checked, by Newton from the fixed-matrix iteration's last iterate where there was one
-            cap = RECHECK_LIMIT * (loading.max_iterations if recheck_assemble is None else NEWTON_ITERATIONS)
-            start = trial if recheck_assemble is not None and np.all(np.isfinite(trial)) else None
-            trial, converged, it = newton(target, cap, recheck_assemble or assemble, start)
-            how = "" if recheck_assemble is None else "Newton on the consistent tangent, "
-            note = (f"converged only on the re-check ({how}{it} iterations)" if converged else
-                    f"no convergence on the re-check ({how}{cap} iterations) either")
+            trial, converged, it, note = _recheck(newton, target, trial, loading.max_iterations,
+                                                  assemble, recheck_assemble)
         if converged and judge is not None:
-            verdict, judged = judge(factor, path.U, target, trial)
+            verdict, judged = judge(walk.factor, path.U, target, trial)
         if not converged or verdict is not None:
             reason = verdict if verdict is not None else f"no convergence after {loading.max_cutbacks} cut-backs"
-            if exhausted() and before is not None and factor - before[0] > ROLLBACK * min_step * (1 + 1e-9):
-                # the carried level was reached by a long step: go back and take that step again in halves
-                a, U_a, state_a, last_step, last_dfactor, entry = before
-                path.history.append({"load_factor": target, "converged": False, "equilibrium": converged,
-                                     "iterations": it, "note": f"{reason}; the level below was reached by a step "
-                                     f"of {factor - a:.4g}: taken again in halves from {a:.6g}", **judged})
-                path.history[entry].update(converged=False, note="not carried: its step was too long to read "
-                                           "the curve at it; taken again in halves")
-                restore(state_a)
-                max_step = dfactor = 0.5 * (factor - a)
-                path.U, factor, before = U_a, a, None
-                converged_increments -= 1
+            entry = {"load_factor": target, "converged": False, "equilibrium": converged, "iterations": it}
+            if (exhausted() and walk.before is not None
+                    and walk.factor - walk.before[0] > ROLLBACK * min_step * (1 + 1e-9)):
+                _roll_back(path, walk, restore, {**entry, **judged}, reason)
                 continue
             if exhausted():
-                path.history.append({"load_factor": target, "converged": False, "equilibrium": converged,
-                                     "iterations": it, "note": "; ".join(n for n in (reason, note) if n), **judged})
+                path.history.append({**entry, "note": "; ".join(n for n in (reason, note) if n), **judged})
                 report.status("")
                 if stop_on_failure:
                     path.failed_at, path.failed_trial = target, trial
@@ -201,22 +198,51 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
                                        f"{loading.max_cutbacks} cut-backs; use more load steps", key="loading",
                                        history=path.history)
             path.cutbacks += 1
-            dfactor *= 0.5
-            path.history.append({"load_factor": target, "converged": False, "equilibrium": converged,
-                                 "iterations": it, "note": (f"{verdict}: " if verdict is not None else "")
-                                 + f"increment cut back to {dfactor:.4g}", **judged})
+            walk.dfactor *= 0.5
+            path.history.append({**entry, "note": (f"{verdict}: " if verdict is not None else "")
+                                 + f"increment cut back to {walk.dfactor:.4g}", **judged})
             continue
         if judge is not None and snapshot is not None:   # where the path may come back to (see ROLLBACK)
-            before = (factor, path.U, snapshot(), last_step, last_dfactor, len(path.history))
-        last_step, last_dfactor = trial - path.U, target - factor
-        path.U, factor = trial, target
+            walk.before = (walk.factor, path.U, snapshot(), walk.last_step, walk.last_dfactor, len(path.history))
+        walk.last_step, walk.last_dfactor = trial - path.U, target - walk.factor
+        path.U, walk.factor = trial, target
         if it <= loading.max_iterations // 2:   # an easy increment: let a cut-back step grow back
-            dfactor = min(2.0 * dfactor, max_step)
-        path.history.append({"load_factor": factor, "converged": True, "iterations": it,
-                             **({"note": note} if note else {}), **judged, **on_converged(factor, path.U)})
-        converged_increments += 1
+            walk.dfactor = min(2.0 * walk.dfactor, walk.max_step)
+        path.history.append({"load_factor": walk.factor, "converged": True, "iterations": it,
+                             **({"note": note} if note else {}), **judged, **on_converged(walk.factor, path.U)})
+        walk.converged += 1
     report.status("")
     return path
+
+
+def _recheck(newton: Callable, target: float, trial: np.ndarray, max_iterations: int, assemble: Callable,
+             recheck_assemble: Callable | None) -> tuple[np.ndarray, bool, int, str]:
+    """The re-check of an increment not converged with the cut-backs spent (the module doc): (the iterate,
+    converged, iterations, the history's note). Newton starts from the fixed-matrix iteration's last iterate
+    where there was one. Where the re-check fails too, the iterate kept is the first attempt's where it is finite:
+    a Newton iterate running away from a mechanism reaches 1e11-1e13 m, a field that shows nothing."""
+    cap = RECHECK_LIMIT * (max_iterations if recheck_assemble is None else NEWTON_ITERATIONS)
+    finite = bool(np.all(np.isfinite(trial)))
+    start = trial if recheck_assemble is not None and finite else None
+    checked, converged, it = newton(target, cap, recheck_assemble or assemble, start)
+    how = "" if recheck_assemble is None else "Newton on the consistent tangent, "
+    if converged:
+        return checked, True, it, f"converged only on the re-check ({how}{it} iterations)"
+    return (trial if finite else checked), False, it, f"no convergence on the re-check ({how}{cap} iterations) either"
+
+
+def _roll_back(path: LoadPath, walk: _Walk, restore: Callable[[Any], None], entry: dict, reason: str) -> None:
+    """The carried level was reached by a step longer than ``ROLLBACK`` of the smallest: go back to its start and
+    take that step again in halves, never growing back beyond them (the module doc)."""
+    a, U_a, state_a, walk.last_step, walk.last_dfactor, carried = walk.before
+    path.history.append({**entry, "note": f"{reason}; the level below was reached by a step "
+                         f"of {walk.factor - a:.4g}: taken again in halves from {a:.6g}"})
+    path.history[carried].update(converged=False, note="not carried: its step was too long to read "
+                                 "the curve at it; taken again in halves")
+    restore(state_a)
+    walk.max_step = walk.dfactor = 0.5 * (walk.factor - a)
+    path.U, walk.factor, walk.before = U_a, a, None
+    walk.converged -= 1
 
 
 def _newton(path: LoadPath, trial: np.ndarray, target: float, cap: int, fixed: np.ndarray, tolerance: float,

@@ -207,9 +207,7 @@ class PlasticSystem:
             with self.clock.measure("factorisation"):
                 factors = self._elastic_factors()
             with self.clock.measure("substitution"):
-                du = np.zeros_like(residual)
-                du[self.free] = factors.solve(residual[self.free])
-            return du
+                return self._solve_free(factors, residual)
         with self.clock.measure("factorisation"):
             if self._lu is None or self._lu[0] is not K:
                 try:
@@ -218,8 +216,7 @@ class PlasticSystem:
                     return self._safeguarded(residual)
                 self.factorisations += 1
         with self.clock.measure("substitution"):
-            du = np.zeros_like(residual)
-            du[self.free] = self._lu[1].solve(residual[self.free])
+            du = self._solve_free(self._lu[1], residual)
         if not np.all(np.isfinite(du)):
             return self._safeguarded(residual)
         return du
@@ -258,9 +255,14 @@ class PlasticSystem:
         increment converges, or is cut back as any other, by the load stepping's criteria. Counted in
         ``safeguarded_steps``."""
         self.safeguarded_steps += 1
-        du = np.zeros_like(residual)
-        du[self.free] = self._elastic_factors().solve(residual[self.free])
-        return du
+        return self._solve_free(self._elastic_factors(), residual)
+
+    def _solve_free(self, factors: Any, rhs: np.ndarray) -> np.ndarray:
+        """(2n,) the solution of the free dofs' system whose ``factors`` are given, for ``rhs`` (2n,); zero at the
+        fixed dofs."""
+        x = np.zeros_like(rhs)
+        x[self.free] = factors.solve(rhs[self.free])
+        return x
 
     def _elastic_factors(self):
         """The factors of the constrained elastic stiffness, computed once (a singular one is a model error)."""
@@ -308,9 +310,7 @@ class PlasticSystem:
 
     def elastic_response(self, F: np.ndarray) -> np.ndarray:
         """U (2n,) of the elastic stiffness under the forces F (2n,), zero at the fixed dofs."""
-        U = np.zeros_like(F)
-        U[self.free] = self._elastic_factors().solve(F[self.free])
-        return U
+        return self._solve_free(self._elastic_factors(), F)
 
 
 @dataclass

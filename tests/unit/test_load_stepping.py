@@ -63,3 +63,18 @@ def test_newton_recheck_fails_a_body_without_equilibrium() -> None:
     assert path.failed_at == 1.0
     assert path.history[-1]["iterations"] <= RECHECK_LIMIT * NEWTON_ITERATIONS
     assert "no convergence on the re-check (Newton" in path.history[-1]["note"]
+
+
+def test_a_failed_recheck_keeps_the_fixed_matrix_iterate_as_the_failed_state() -> None:
+    """Where Newton's re-check runs away (f_int = tanh u under 1.5: its iterates grow without bound), the failed
+    level's state is the fixed-matrix iteration's last iterate, a bounded field, not Newton's runaway one."""
+    def assemble(U, t):
+        return np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[1.0 / np.cosh(np.clip(U[0], -50, 50)) ** 2 + 1e-12]])
+    loading = Loading(steps=1, tolerance=1e-6, max_iterations=10, max_cutbacks=0)
+    path = step_loads(1, loading, np.array([], int), np.array([]),
+                      lambda U, t: (np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[2.0]])),
+                      lambda K, r: r / K[0, 0], lambda t, U: {}, stop_on_failure=True, recheck=True,
+                      recheck_assemble=assemble)
+    assert path.failed_at == 1.0
+    # ten plain steps of (1.5 - tanh u) / 2 from u = 0 stay below 10 * 1.5 / 2
+    assert np.isfinite(path.failed_trial[0]) and abs(path.failed_trial[0]) < 7.5
