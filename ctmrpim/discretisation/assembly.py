@@ -54,7 +54,7 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     tptr = kernels.transpose_pattern(indptr, indices, n, trow, tent)
     blocks = [(a, min(a + ROW_BLOCK, n)) for a in range(0, n, ROW_BLOCK)]
     counts = np.zeros(n, np.int64)
-    _run(lambda ab: kernels.row_counts(indptr, indices, tptr, trow, n, *ab, counts), blocks)
+    run_blocks(lambda ab: kernels.row_counts(indptr, indices, tptr, trow, n, *ab, counts), blocks)
     node_start = np.zeros(n + 1, np.int64)
     np.cumsum(counts, out=node_start[1:])
     nnz = 4 * int(node_start[-1])
@@ -67,10 +67,10 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     k_indptr[-1] = nnz
     # symmetric K (Galerkin, symmetric D) on sorted rows: the upper blocks summed, the lower ones copied
     upper = test is None and np.array_equal(D, D.T) and dNdx.has_canonical_format
-    _run(lambda ab: kernels.stiffness_rows(indptr, indices, *data, w, Dc, tptr, trow, tent, n, node_start, *ab,
-                                           k_indices, k_data, upper), blocks)
+    run_blocks(lambda ab: kernels.stiffness_rows(indptr, indices, *data, w, Dc, tptr, trow, tent, n, node_start,
+                                                 *ab, k_indices, k_data, upper), blocks)
     if upper:
-        _run(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks)
+        run_blocks(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks)
     K = sp.csr_matrix((k_data, k_indices, k_indptr), shape=(2 * n, 2 * n), copy=False)
     K.has_sorted_indices = True
     K.has_canonical_format = True
@@ -139,7 +139,7 @@ def _on_pattern(a: sp.csr_matrix, pattern: sp.csr_matrix) -> np.ndarray:
     return out
 
 
-def _run(work, blocks: list[tuple[int, int]]) -> None:
+def run_blocks(work, blocks: list[tuple[int, int]]) -> None:
     """``work(block)`` for every block, on a thread pool where there is more than one (the kernels release
     the GIL)."""
     if len(blocks) > 1 and THREADS > 1:

@@ -21,7 +21,7 @@ from numba import njit
 
 
 @njit(cache=True, fastmath={"reassoc", "contract"})
-def _gradient(indptr, indices, dx, dy, d, out):
+def _gradient(indptr, indices, dx, dy, d, out, identity):
     for p in range(len(indptr) - 1):
         a = b = c = e = 0.0
         for k in range(indptr[p], indptr[p + 1]):
@@ -30,7 +30,7 @@ def _gradient(indptr, indices, dx, dy, d, out):
             b += dy[k] * d[j, 0]
             c += dx[k] * d[j, 1]
             e += dy[k] * d[j, 1]
-        out[p, 0], out[p, 1], out[p, 2], out[p, 3] = 1.0 + a, b, c, 1.0 + e
+        out[p, 0], out[p, 1], out[p, 2], out[p, 3] = identity + a, b, c, identity + e
 
 
 @njit(cache=True, fastmath={"reassoc", "contract"})
@@ -53,10 +53,10 @@ class GradientOperator:
         self.indptr, self.indices = dNdx.indptr, dNdx.indices
         self.dx, self.dy = np.ascontiguousarray(dNdx.data, float), np.ascontiguousarray(dNdy.data, float)
 
-    def gradient(self, d: np.ndarray) -> np.ndarray:
-        """(m, 4) F = I + grad d (xx, xy, yx, yy) of nodal displacements d (n, 2)."""
+    def gradient(self, d: np.ndarray, identity: float = 1.0) -> np.ndarray:
+        """(m, 4) F = I + grad d (xx, xy, yx, yy) of nodal displacements d (n, 2); ``identity = 0``: grad d."""
         out = np.empty((self.shape[0], 4))
-        _gradient(self.indptr, self.indices, self.dx, self.dy, np.ascontiguousarray(d, float), out)
+        _gradient(self.indptr, self.indices, self.dx, self.dy, np.ascontiguousarray(d, float), out, identity)
         return out
 
     def force(self, wP: np.ndarray) -> np.ndarray:
@@ -64,3 +64,22 @@ class GradientOperator:
         out = np.zeros((self.shape[1], 2))
         _force(self.indptr, self.indices, self.dx, self.dy, np.ascontiguousarray(wP, float), out)
         return out
+
+
+def rpim_layout(G: sp.bsr_matrix) -> bool:
+    """Whether G (4m x 2n) is block-sparse with every 4 x 2 block [[a, 0], [b, 0], [0, a], [0, b]] (a = dN/dX,
+    b = dN/dY: :func:`ctmrpim.discretisation.lagrangian_operators.gradient_operator`'s layout)."""
+    if not (isinstance(G, sp.bsr_matrix) and G.blocksize == (4, 2)):
+        return False
+    d = G.data
+    return bool(np.array_equal(d[:, 2, 1], d[:, 0, 0]) and np.array_equal(d[:, 3, 1], d[:, 1, 0])
+                and not np.any(d[:, 2:, 0]) and not np.any(d[:, :2, 1]))
+
+
+def from_blocks(G: sp.bsr_matrix) -> GradientOperator | None:
+    """The operator of a G in :func:`rpim_layout`, or None."""
+    if not rpim_layout(G):
+        return None
+    m, n = G.shape[0] // 4, G.shape[1] // 2
+    return GradientOperator(sp.csr_matrix((G.data[:, 0, 0], G.indices, G.indptr), shape=(m, n)),
+                            sp.csr_matrix((G.data[:, 1, 0], G.indices, G.indptr), shape=(m, n)))

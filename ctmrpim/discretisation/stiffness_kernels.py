@@ -246,3 +246,58 @@ def mirror_lower(k_indptr, k_indices, k_data, r0, r1):
             k_data[t + 1] = k_data[v]              # K[2J, 2I + 1] = K[2I + 1, 2J]
             k_data[a1 + (t - a0)] = k_data[u + 1]  # K[2J + 1, 2I] = K[2I, 2J + 1]
             k_data[a1 + (t - a0) + 1] = k_data[v + 1]
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def pointwise_rows(indptr, indices, dx, dy, tdx, tdy, w, slot, D, tptr, trow, tent, r0, r1,
+                   k_indptr, k_indices, k_data):
+    """k_data += sum_p w_p B~_I^T D_p B_J over the points p with slot[p] >= 0 (D_p = D[slot[p]], any 3 x 3), for
+    the node rows r0 <= I < r1, on K's existing CSR pattern (k_indptr, k_indices: rows 2I and 2I + 1); (dx, dy)
+    the trial and (tdx, tdy) the test gradients on the points' pattern (indptr, indices), (tptr, trow, tent) its
+    transpose (:func:`transpose_pattern`). False where a block has no place in K's pattern (``k_data`` is then
+    partly updated: the caller works on a copy)."""
+    n2 = len(k_indptr) - 1
+    pos0 = np.full(n2, -1, np.int64)     # the entry of column c in row 2I, and in row 2I + 1
+    pos1 = np.full(n2, -1, np.int64)
+    for i in range(r0, r1):
+        touched = False
+        for t in range(tptr[i], tptr[i + 1]):
+            if slot[trow[t]] >= 0:
+                touched = True
+                break
+        if not touched:
+            continue
+        for k in range(k_indptr[2 * i], k_indptr[2 * i + 1]):
+            pos0[k_indices[k]] = k
+        for k in range(k_indptr[2 * i + 1], k_indptr[2 * i + 2]):
+            pos1[k_indices[k]] = k
+        for t in range(tptr[i], tptr[i + 1]):
+            p = trow[t]
+            s = slot[p]
+            if s < 0:
+                continue
+            e = tent[t]
+            ax = tdx[e] * w[p]
+            ay = tdy[e] * w[p]
+            d00, d01, d02 = D[s, 0, 0], D[s, 0, 1], D[s, 0, 2]
+            d10, d11, d12 = D[s, 1, 0], D[s, 1, 1], D[s, 1, 2]
+            d20, d21, d22 = D[s, 2, 0], D[s, 2, 1], D[s, 2, 2]
+            for k in range(indptr[p], indptr[p + 1]):
+                j = indices[k]
+                q00, q01, q10, q11 = pos0[2 * j], pos0[2 * j + 1], pos1[2 * j], pos1[2 * j + 1]
+                if q00 < 0 or q01 < 0 or q10 < 0 or q11 < 0:
+                    return False
+                a = ax * dx[k]
+                b = ax * dy[k]
+                g = ay * dx[k]
+                h = ay * dy[k]
+                # B~_I^T D B_J with B = [[d/dx, 0], [0, d/dy], [d/dy, d/dx]], as in stiffness_rows
+                k_data[q00] += d00 * a + d02 * b + d20 * g + d22 * h
+                k_data[q01] += d01 * b + d02 * a + d21 * h + d22 * g
+                k_data[q10] += d10 * g + d12 * h + d20 * a + d22 * b
+                k_data[q11] += d11 * h + d12 * g + d21 * b + d22 * a
+        for k in range(k_indptr[2 * i], k_indptr[2 * i + 1]):
+            pos0[k_indices[k]] = -1
+        for k in range(k_indptr[2 * i + 1], k_indptr[2 * i + 2]):
+            pos1[k_indices[k]] = -1
+    return True

@@ -37,12 +37,16 @@ from typing import Any, Callable
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from threadpoolctl import threadpool_limits
 
+from ctmrpim.discretisation.gradient_operator import from_blocks
+from ctmrpim.discretisation.pointwise_stiffness import PointwiseStiffness
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import ELASTIC, MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.settings import Loading
 from ctmrpim.result import Result
+from ctmrpim.solvers.banded_lu import BandedLU
 from ctmrpim.solvers.limit_criteria import SettlementCriterion, limit_load
 from ctmrpim.solvers.load_stepping import LoadPath, step_loads
 from ctmrpim.solvers.weak_form import internal_force, tangent
@@ -112,9 +116,17 @@ class PlasticSystem:
         self._K_elastic: sp.csr_matrix | None = None
         self._lu = None
         self._lu_elastic = None             # the elastic stiffness's factors, for the safeguarded steps
+        self._pointwise: PointwiseStiffness | bool | None = None   # compiled tangent corrector (False: none)
+        self._band: BandedLU | bool | None = None   # the banded LU of the elastic pattern (False: SuperLU)
+        # G's and the test gradients' products as compiled passes over (dN/dX, dN/dY) where G is in the RPIM
+        # layout (half the work of the 4 x 2 blocks' products, whose other half are zeros)
+        self._gradient = from_blocks(self.G)
+        self._force = self._gradient if self.test is None or self._gradient is None else from_blocks(self.test)
 
     def strain_increment(self, U: np.ndarray) -> np.ndarray:
         """(m, 3) exx, eyy, gxy at the points from the committed dofs to the interleaved dofs U (2n,)."""
+        if self._gradient is not None:
+            return self._gradient.gradient((U - self.U).reshape(-1, 2), identity=0.0) @ FROM_GRAD.T
         return (self.G @ (U - self.U)).reshape(-1, 4) @ FROM_GRAD.T
 
     def trial_state(self, material: MohrCoulomb, U: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -150,7 +162,10 @@ class PlasticSystem:
     def _internal(self, stress: np.ndarray) -> np.ndarray:
         """G~^T (w sigma), less the Dirichlet consistency term's force where there is one."""
         P = stress[:, :3] @ TO_P.T
-        f = internal_force(self.G, P, self.w, self.GT)
+        if self._force is not None:
+            f = self._force.force(P * self.w[:, None]).ravel()
+        else:
+            f = internal_force(self.G, P, self.w, self.GT)
         return f - self.dirichlet.force(P) if self.consistent else f
 
     def internal_force(self) -> np.ndarray:
@@ -186,15 +201,26 @@ class PlasticSystem:
                 plastic = np.flatnonzero(region != ELASTIC)
                 self._K = self._K_elastic          # its factors are kept while no point is plastic
                 if len(plastic):
-                    dA = TO_P[None] @ (material.tangent(self.stress[plastic], de[plastic])
-                                       - material.D("strain")[None]) @ FROM_GRAD[None]
-                    Gp = block_rows(self.G, plastic)
-                    GTp = Gp.T if self.test is None else block_rows(self.test, plastic).T
-                    self._K = self._K_elastic + tangent(Gp, dA, self.w[plastic], GTp)
-                    if self.consistent:
-                        self._K = self._K - self.dirichlet.stiffness(Gp, dA, plastic)
+                    dD = material.tangent(self.stress[plastic], de[plastic]) - material.D("strain")[None]
+                    self._K = self._plastic_tangent(plastic, dD)
                 self.tangents += 1
         return f_ext, f_int, self._K
+
+    def _plastic_tangent(self, plastic: np.ndarray, dD: np.ndarray) -> sp.csr_matrix:
+        """K_elastic + the correction of the ``plastic`` points (k,) with D_ep - D = ``dD`` (k, 3, 3): by the compiled
+        point-wise pass where G is in the RPIM layout (:mod:`ctmrpim.discretisation.pointwise_stiffness`), else,
+        and with a Dirichlet consistency term, by sparse products over the plastic points' rows of G."""
+        if self._pointwise is None:
+            self._pointwise = PointwiseStiffness.build(self.G, self.test, self.w) or False
+        if self._pointwise and not self.consistent:
+            K = self._pointwise.corrected(self._K_elastic, plastic, dD)
+            if K is not None:
+                return K
+        dA = TO_P[None] @ dD @ FROM_GRAD[None]
+        Gp = block_rows(self.G, plastic)
+        GTp = Gp.T if self.test is None else block_rows(self.test, plastic).T
+        K = self._K_elastic + tangent(Gp, dA, self.w[plastic], GTp)
+        return K - self.dirichlet.stiffness(Gp, dA, plastic) if self.consistent else K
 
     def solve(self, K: sp.csr_matrix, residual: np.ndarray) -> np.ndarray:
         """du (2n,) with K du = ``residual`` (2n,) at the free dofs and du = 0 at the fixed ones, reusing the LU
@@ -221,14 +247,25 @@ class PlasticSystem:
             return self._safeguarded(residual)
         return du
 
-    def _factorise(self, K: sp.csr_matrix):
+    def _factorise(self, K: sp.csr_matrix, banded: bool = True):
         """SuperLU factors of K (2n x 2n) at the free dofs; RuntimeError where a pivot is exactly zero.
 
         A row or column without a non-zero entry (dofs whose every point returned to the apex: D_ep = 0) is
         refused here, before SuperLU sees it: SuperLU's pivoting reads an uninitialised index on such a
         column and crashes the interpreter now and then (scipy 1.11, segmentation fault in ``splu``) instead
         of reporting the singular factor. Measured on the coarse phi = 20 deg footing by FE P2: every one of
-        the 49 tangents SuperLU found exactly singular had such rows or columns, none of the 142 regular ones."""
+        the 49 tangents SuperLU found exactly singular had such rows or columns, none of the 142 regular ones.
+
+        Where the elastic stiffness's band is narrow against its rows (meshfree supports), a Newton tangent on
+        its pattern is factorised by the banded LU instead (:mod:`ctmrpim.solvers.banded_lu`), whose zero pivot on
+        such a row is its RuntimeError. Not the elastic stiffness (``banded`` False): its factors serve every
+        iteration of the elastic-stiffness iteration, and the band's substitution is about twice SuperLU's work
+        (8.4 against 4.5 MFlop on the 1928-node slope)."""
+        if banded and self._band is None:
+            band = BandedLU(self.elastic_stiffness(), self.free)
+            self._band = band if band.worthwhile else False
+        if banded and self._band and self._band.fits(K):
+            return self._band.factorise(K)
         Kff = K[self.free][:, self.free].tocsc()
         magnitude = abs(Kff)
         if magnitude.max(axis=0).nnz < Kff.shape[1] or magnitude.max(axis=1).nnz < Kff.shape[0]:
@@ -268,7 +305,7 @@ class PlasticSystem:
         """The factors of the constrained elastic stiffness, computed once (a singular one is a model error)."""
         if self._lu_elastic is None:
             try:
-                self._lu_elastic = self._factorise(self.elastic_stiffness())
+                self._lu_elastic = self._factorise(self.elastic_stiffness(), banded=False)
             except RuntimeError as exc:
                 raise self._unconstrained(exc) from None
             self.factorisations += 1
@@ -302,11 +339,15 @@ class PlasticSystem:
             self.commit(material_at(t), U)
             return on_converged(t, U)
 
-        return step_loads(len(self.U), loading, self.fixed,
-                          self.fixed_values if fixed_values is None else fixed_values, assemble, self.solve,
-                          converged, U0=self.U, stop_on_failure=stop_on_failure, anderson=ANDERSON,
-                          judge=judge, recheck=recheck, snapshot=self.snapshot, restore=self.restore,
-                          recheck_assemble=assemble_consistent if self.tangent == "elastic" else None)
+        # one BLAS thread: the iteration's dense work is small (Anderson's least squares on 10 columns, banded
+        # solves), and OpenBLAS's threads spin-wait for a busy core (measured under load: the least squares of
+        # the 1928-node slope 9-28 ms on two threads, 1.1 ms on one, 40 % of the search's time)
+        with threadpool_limits(1):
+            return step_loads(len(self.U), loading, self.fixed,
+                              self.fixed_values if fixed_values is None else fixed_values, assemble, self.solve,
+                              converged, U0=self.U, stop_on_failure=stop_on_failure, anderson=ANDERSON,
+                              judge=judge, recheck=recheck, snapshot=self.snapshot, restore=self.restore,
+                              recheck_assemble=assemble_consistent if self.tangent == "elastic" else None)
 
     def elastic_response(self, F: np.ndarray) -> np.ndarray:
         """U (2n,) of the elastic stiffness under the forces F (2n,), zero at the fixed dofs."""

@@ -1,0 +1,57 @@
+"""The compiled point-wise stiffness correction (the consistent Mohr-Coulomb tangent's) equals the sparse products
+it replaces, for any per-point D (non-symmetric: non-associated flow), with and without Petrov-Galerkin test
+gradients, and refuses what it cannot do (a G not in the RPIM layout, a block outside K_0's pattern)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from ctmrpim.discretisation.lagrangian_operators import gradient_operator
+from ctmrpim.discretisation.pointwise_stiffness import PointwiseStiffness
+from ctmrpim.solvers.plastic_system import FROM_GRAD, TO_P, block_rows
+from ctmrpim.solvers.weak_form import tangent
+
+
+def _gradients(seed: int, m: int = 300, n: int = 80, support: int = 12):
+    """(dN/dx, dN/dy) at m points with ``support`` random nodes each (one pattern, sorted columns)."""
+    rng = np.random.default_rng(seed)
+    cols = np.sort(np.array([rng.choice(n, support, replace=False) for _ in range(m)]), axis=1)
+    indptr = np.arange(0, m * support + 1, support)
+    return tuple(sp.csr_matrix((rng.normal(size=m * support), cols.ravel(), indptr), shape=(m, n)) for _ in "xy")
+
+
+@pytest.mark.parametrize("petrov", [False, True])
+def test_the_compiled_correction_equals_the_sparse_products(petrov: bool) -> None:
+    dx, dy = _gradients(1)
+    G = gradient_operator(dx, dy)
+    test = None
+    if petrov:   # test gradients on the same pattern, other values
+        rng = np.random.default_rng(7)
+        test = gradient_operator(sp.csr_matrix((rng.normal(size=dx.nnz), dx.indices, dx.indptr), shape=dx.shape),
+                                 sp.csr_matrix((rng.normal(size=dx.nnz), dx.indices, dx.indptr), shape=dx.shape))
+    m = dx.shape[0]
+    rng = np.random.default_rng(3)
+    w = rng.uniform(0.5, 1.5, m)
+    GT = G.T if test is None else test.T
+    K0 = tangent(G, np.broadcast_to(TO_P @ np.eye(3) @ FROM_GRAD, (m, 4, 4)), w, GT)
+    points = np.sort(rng.choice(m, m // 3, replace=False))
+    D = rng.normal(size=(len(points), 3, 3))      # non-symmetric
+    corrector = PointwiseStiffness.build(G, test, w)
+    K = corrector.corrected(K0, points, D)
+    Gp = block_rows(G, points)
+    GTp = Gp.T if test is None else block_rows(test, points).T
+    expected = K0 + tangent(Gp, TO_P[None] @ D @ FROM_GRAD[None], w[points], GTp)
+    assert abs(K - expected).max() <= 1e-12 * abs(expected).max()
+    assert K.nnz == K0.nnz        # on K_0's pattern; K_0 itself unchanged
+    assert abs(K0 - tangent(G, np.broadcast_to(TO_P @ FROM_GRAD, (m, 4, 4)), w, GT)).max() == 0
+
+
+def test_what_it_cannot_do_is_refused() -> None:
+    dx, dy = _gradients(2)
+    G = gradient_operator(dx, dy)
+    assert PointwiseStiffness.build(G.tocsr().tobsr(blocksize=(4, 1)), None, np.ones(dx.shape[0])) is None
+    w = np.ones(dx.shape[0])
+    corrector = PointwiseStiffness.build(G, None, w)
+    empty = sp.identity(G.shape[1], format="csr")        # a K_0 whose pattern lacks the coupling blocks
+    assert corrector.corrected(empty, np.array([0, 5]), np.ones((2, 3, 3))) is None
