@@ -186,3 +186,51 @@ def point_update(material: MohrCoulomb, f: np.ndarray, stress: np.ndarray, plast
         raise ProblemError("Mohr-Coulomb return: a stress state beyond both edges with phi = 0 (no apex); the "
                            "strain increment is too large")
     return PointUpdate(out_stress, out_plastic, region, float(dissipation), out_viscous, float(viscous_work))
+
+
+@njit(cache=True)
+def _small_strain(stress, de, G, K, c, sphi, cphi, spsi, out, region):
+    lam = K - 2.0 * G / 3.0
+    for p in range(stress.shape[0]):
+        e0, e1, e2 = de[p, 0], de[p, 1], de[p, 2]
+        tr = e0 + e1
+        t0 = stress[p, 0] + lam * tr + 2.0 * G * e0
+        t1 = stress[p, 1] + lam * tr + 2.0 * G * e1
+        t2 = stress[p, 2] + G * e2
+        t3 = stress[p, 3] + lam * tr
+        s1, s2, s3, nx, ny, zslot = _sorted_principal(t0, t1, t2, t3)
+        fy = (s1 - s3) + (s1 + s3) * sphi - 2.0 * c * cphi
+        reg = 0
+        if fy > YIELD_TOL * (c + max(abs(s1), abs(s2), abs(s3))):
+            s1, s2, s3, reg = _return(s1, s2, s3, G, K, c, sphi, cphi, spsi)
+            if zslot == 0:
+                szz, big, small = s1, s2, s3
+            elif zslot == 1:
+                szz, big, small = s2, s1, s3
+            else:
+                szz, big, small = s3, s1, s2
+            t0 = big * nx * nx + small * ny * ny
+            t1 = big * ny * ny + small * nx * nx
+            t2 = (big - small) * nx * ny
+            t3 = szz
+        region[p] = reg
+        out[p, 0], out[p, 1], out[p, 2], out[p, 3] = t0, t1, t2, t3
+
+
+def small_strain_update(material: MohrCoulomb, stress: np.ndarray, dstrain: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`ctmrpim.materials.mohr_coulomb.MohrCoulomb.update` compiled, for real increments and no tension
+    cut-off: the stress (m, 4) after the strain increments ``dstrain`` (m, 3: exx, eyy, gxy) from ``stress``
+    (m, 4), and the return region of each point. One pass over the points instead of about 40 array passes
+    (the implicit solvers' residuals; their tangents keep the numpy form's complex steps)."""
+    if material.tension is not None:
+        raise ValueError("small_strain_update: the tension cut-off is not compiled; use MohrCoulomb.update")
+    m = len(stress)
+    out, region = np.empty((m, 4)), np.empty(m, np.int8)
+    phi, psi = math.radians(material.phi), math.radians(material.psi)
+    _small_strain(np.ascontiguousarray(stress, float), np.ascontiguousarray(dstrain, float), material.G,
+                  material.K, material.c, math.sin(phi), math.cos(phi), math.sin(psi), out, region)
+    if material.phi == 0 and np.any(region == APEX):
+        raise ProblemError("Mohr-Coulomb return: a stress state beyond both edges with phi = 0 (no apex); the "
+                           "strain increment is too large")
+    return out, region

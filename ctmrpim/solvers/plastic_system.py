@@ -43,6 +43,7 @@ from ctmrpim.discretisation.gradient_operator import from_blocks
 from ctmrpim.discretisation.pointwise_stiffness import PointwiseStiffness
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import ELASTIC, MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
+from ctmrpim.materials.mohr_coulomb_kernel import small_strain_update
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.settings import Loading
 from ctmrpim.result import Result
@@ -132,8 +133,16 @@ class PlasticSystem:
     def trial_state(self, material: MohrCoulomb, U: np.ndarray) -> tuple[np.ndarray, ...]:
         """(U, stress, region, plastic strain) at U from the committed state, laid out as a snapshot."""
         de = self.strain_increment(U)
-        stress, region = material.update(self.stress, de)
+        stress, region = self._return_map(material, de)
         return U.copy(), stress, region, self.plastic_strain + plastic_strain_increment(material, de, stress - self.stress)
+
+    def _return_map(self, material: MohrCoulomb, de: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(stress, region) at the points after the strain increments ``de`` (m, 3) from the committed stress: the
+        compiled return where there is no tension cut-off (:func:`~ctmrpim.materials.mohr_coulomb_kernel.
+        small_strain_update`, equal to the numpy form to round-off), else the numpy form."""
+        if material.tension is None:
+            return small_strain_update(material, self.stress, de)
+        return material.update(self.stress, de)
 
     def commit(self, material: MohrCoulomb, U: np.ndarray) -> None:
         """Make the trial state at U (2n,) under ``material`` the committed one."""
@@ -186,7 +195,7 @@ class PlasticSystem:
         consistent tangent, as ``matrix`` says (default: the system's ``tangent``)."""
         with self.clock.measure("return mapping"):
             de = self.strain_increment(U)
-            stress, region = material.update(self.stress, de)
+            stress, region = self._return_map(material, de)
         with self.clock.measure("internal force"):
             f_ext = self.external_force(load_factor)
             f_int = self._internal(stress)

@@ -1,11 +1,13 @@
-"""The compiled Mohr-Coulomb point update of the explicit step (ctmrpim.materials.mohr_coulomb_kernel)."""
+"""The compiled Mohr-Coulomb point updates (ctmrpim.materials.mohr_coulomb_kernel): the explicit step's, and the
+small-strain return of the implicit solvers' residuals."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, MohrCoulomb, plastic_strain_increment
-from ctmrpim.materials.mohr_coulomb_kernel import point_update
+from ctmrpim.materials.mohr_coulomb_kernel import point_update, small_strain_update
 from ctmrpim.materials.objective_stress import hughes_winget_c, rotate_c
 
 
@@ -42,3 +44,32 @@ def test_compiled_point_update_matches_the_numpy_forms(c, psi):
     want_viscous[dead] = 0.0
     assert np.abs(viscous - want_viscous).max() < 1e-12 * np.abs(want_viscous).max()
     assert work == pytest.approx(w[~dead] @ strain[~dead].sum(axis=1), rel=1e-12)   # unit old viscous stress
+
+
+@pytest.mark.parametrize("c, phi, psi", [(0.0, 30.0, 0.0), (2.0e3, 19.8, 10.0), (1.0e4, 30.0, 30.0), (1.0e4, 0.0, 0.0)])
+def test_compiled_small_strain_return_matches_the_numpy_form(c, phi, psi):
+    """The implicit solvers' compiled return is MohrCoulomb.update point for point, every region (the apex where
+    phi > 0), to round-off; beyond both edges with phi = 0 (no apex) it refuses as the numpy form does; the
+    tension cut-off is not compiled and says so."""
+    material = MohrCoulomb(E=1e7, nu=0.3, c=c, phi=phi, psi=psi, density=2000.0)
+    rng = np.random.default_rng(11)
+    m = 5000
+    p = rng.uniform(-500.0, 4e4, m)
+    stress = np.c_[-p * rng.uniform(0.3, 1.2, m), -p, p * rng.uniform(-0.4, 0.4, m), -p * rng.uniform(0.5, 1.0, m)]
+    stress, _ = material.update(stress, np.zeros((m, 3)))
+    de = 10.0 ** rng.uniform(-6, -2.5, (m, 1)) * rng.standard_normal((m, 3))
+    if phi == 0:
+        de *= 1e-2          # within the edges: a Tresca body has no apex to return to
+    try:
+        want, want_region = material.update(stress, de)
+    except ProblemError:
+        with pytest.raises(ProblemError, match="no apex"):
+            small_strain_update(material, stress, de)
+        return
+    got, region = small_strain_update(material, stress, de)
+    assert {ELASTIC, MAIN, RIGHT, LEFT} <= set(region) and (c > 0 or phi == 0 or APEX in set(region))
+    assert np.array_equal(region, want_region)
+    assert np.abs(got - want).max() < 1e-10 * np.abs(stress).max()
+    with pytest.raises(ValueError, match="tension cut-off"):
+        small_strain_update(MohrCoulomb(E=1e7, nu=0.3, c=c, phi=phi, psi=psi, density=2000.0, tension=1e3),
+                            stress, de)
