@@ -16,6 +16,7 @@ from ctmrpim.discretisation import assembly, consistent_integration
 from ctmrpim.discretisation.boundary_loads import reference_loads
 from ctmrpim.discretisation.configuration import BoundaryTags, Configuration, boundary_tags, reference_configuration
 from ctmrpim.discretisation.nodal_average import RADIUS, KernelAverage
+from ctmrpim.discretisation.point_products import PointProducts
 from ctmrpim.discretisation.state_transfer import NodalProjection
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
@@ -41,7 +42,8 @@ def ctm_plastic_system(case: Case, timer: Timer) -> tuple[PlasticSystem, Configu
     system = PlasticSystem(conf.block_gradient(), conf.w, tags.fixed, tags.fixed_values,
                            lambda factor: loads.forces(conf.x, factor)[0],
                            assembly.body_force_vector(conf.N, conf.w, problem), problem.material,
-                           tangent=case.loading.tangent, test=test, dirichlet=dirichlet)
+                           tangent=case.loading.tangent, test=test, dirichlet=dirichlet,
+                           products=PointProducts.build(conf.block_gradient(), test, conf.w))
     return system, conf, tags
 
 

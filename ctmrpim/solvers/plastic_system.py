@@ -39,8 +39,6 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
 
-from ctmrpim.discretisation.gradient_operator import from_blocks
-from ctmrpim.discretisation.pointwise_stiffness import PointwiseStiffness
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import ELASTIC, MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
 from ctmrpim.materials.mohr_coulomb_kernel import small_strain_update
@@ -105,6 +103,7 @@ class PlasticSystem:
     clock: Timer = field(default_factory=Timer)   # seconds per phase of the iterations
     test: sp.bsr_matrix | None = None       # ctm-vci: G of the corrected test gradients (Petrov-Galerkin)
     dirichlet: Any = None                   # ctm-vci: its Dirichlet consistency term (RecoveredDirichletTerm)
+    products: Any = None                    # compiled products over the points (CTM-RPIM's PointProducts), if any
 
     def __post_init__(self) -> None:
         self.GT = (self.G if self.test is None else self.test).T
@@ -117,17 +116,12 @@ class PlasticSystem:
         self._K_elastic: sp.csr_matrix | None = None
         self._lu = None
         self._lu_elastic = None             # the elastic stiffness's factors, for the safeguarded steps
-        self._pointwise: PointwiseStiffness | bool | None = None   # compiled tangent corrector (False: none)
         self._band: BandedLU | bool | None = None   # the banded LU of the elastic pattern (False: SuperLU)
-        # G's and the test gradients' products as compiled passes over (dN/dX, dN/dY) where G is in the RPIM
-        # layout (half the work of the 4 x 2 blocks' products, whose other half are zeros)
-        self._gradient = from_blocks(self.G)
-        self._force = self._gradient if self.test is None or self._gradient is None else from_blocks(self.test)
 
     def strain_increment(self, U: np.ndarray) -> np.ndarray:
         """(m, 3) exx, eyy, gxy at the points from the committed dofs to the interleaved dofs U (2n,)."""
-        if self._gradient is not None:
-            return self._gradient.gradient((U - self.U).reshape(-1, 2), identity=0.0) @ FROM_GRAD.T
+        if self.products is not None:
+            return self.products.gradient(U - self.U) @ FROM_GRAD.T
         return (self.G @ (U - self.U)).reshape(-1, 4) @ FROM_GRAD.T
 
     def trial_state(self, material: MohrCoulomb, U: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -171,8 +165,8 @@ class PlasticSystem:
     def _internal(self, stress: np.ndarray) -> np.ndarray:
         """G~^T (w sigma), less the Dirichlet consistency term's force where there is one."""
         P = stress[:, :3] @ TO_P.T
-        if self._force is not None:
-            f = self._force.force(P * self.w[:, None]).ravel()
+        if self.products is not None:
+            f = self.products.force(P)
         else:
             f = internal_force(self.G, P, self.w, self.GT)
         return f - self.dirichlet.force(P) if self.consistent else f
@@ -217,12 +211,10 @@ class PlasticSystem:
 
     def _plastic_tangent(self, plastic: np.ndarray, dD: np.ndarray) -> sp.csr_matrix:
         """K_elastic + the correction of the ``plastic`` points (k,) with D_ep - D = ``dD`` (k, 3, 3): by the compiled
-        point-wise pass where G is in the RPIM layout (:mod:`ctmrpim.discretisation.pointwise_stiffness`), else,
-        and with a Dirichlet consistency term, by sparse products over the plastic points' rows of G."""
-        if self._pointwise is None:
-            self._pointwise = PointwiseStiffness.build(self.G, self.test, self.w) or False
-        if self._pointwise and not self.consistent:
-            K = self._pointwise.corrected(self._K_elastic, plastic, dD)
+        point-wise pass of the ``products`` where there are (CTM-RPIM's), else, and with a Dirichlet consistency
+        term, by sparse products over the plastic points' rows of G."""
+        if self.products is not None and not self.consistent:
+            K = self.products.corrected(self._K_elastic, plastic, dD)
             if K is not None:
                 return K
         dA = TO_P[None] @ dD @ FROM_GRAD[None]

@@ -1,6 +1,7 @@
-"""The compiled point-wise stiffness correction (the consistent Mohr-Coulomb tangent's) equals the sparse products
-it replaces, for any per-point D (non-symmetric: non-associated flow), with and without Petrov-Galerkin test
-gradients, and refuses what it cannot do (a G not in the RPIM layout, a block outside K_0's pattern)."""
+"""The Mohr-Coulomb system's compiled products over the points equal the sparse products they replace: the gradient,
+the internal force and the consistent tangent's point-wise correction, for any per-point D (non-symmetric:
+non-associated flow), with and without Petrov-Galerkin test gradients; what they cannot do is refused (a G not in
+the RPIM layout, a block outside K_0's pattern)."""
 from __future__ import annotations
 
 import numpy as np
@@ -8,9 +9,9 @@ import pytest
 import scipy.sparse as sp
 
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator
-from ctmrpim.discretisation.pointwise_stiffness import PointwiseStiffness
+from ctmrpim.discretisation.point_products import PointProducts
 from ctmrpim.solvers.plastic_system import FROM_GRAD, TO_P, block_rows
-from ctmrpim.solvers.weak_form import tangent
+from ctmrpim.solvers.weak_form import internal_force, tangent
 
 
 def _gradients(seed: int, m: int = 300, n: int = 80, support: int = 12):
@@ -22,7 +23,7 @@ def _gradients(seed: int, m: int = 300, n: int = 80, support: int = 12):
 
 
 @pytest.mark.parametrize("petrov", [False, True])
-def test_the_compiled_correction_equals_the_sparse_products(petrov: bool) -> None:
+def test_the_compiled_products_equal_the_sparse_products(petrov: bool) -> None:
     dx, dy = _gradients(1)
     G = gradient_operator(dx, dy)
     test = None
@@ -37,21 +38,25 @@ def test_the_compiled_correction_equals_the_sparse_products(petrov: bool) -> Non
     K0 = tangent(G, np.broadcast_to(TO_P @ np.eye(3) @ FROM_GRAD, (m, 4, 4)), w, GT)
     points = np.sort(rng.choice(m, m // 3, replace=False))
     D = rng.normal(size=(len(points), 3, 3))      # non-symmetric
-    corrector = PointwiseStiffness.build(G, test, w)
-    K = corrector.corrected(K0, points, D)
+    products = PointProducts.build(G, test, w)
+    K = products.corrected(K0, points, D)
     Gp = block_rows(G, points)
     GTp = Gp.T if test is None else block_rows(test, points).T
     expected = K0 + tangent(Gp, TO_P[None] @ D @ FROM_GRAD[None], w[points], GTp)
     assert abs(K - expected).max() <= 1e-12 * abs(expected).max()
     assert K.nnz == K0.nnz        # on K_0's pattern; K_0 itself unchanged
     assert abs(K0 - tangent(G, np.broadcast_to(TO_P @ FROM_GRAD, (m, 4, 4)), w, GT)).max() == 0
+    dU, P = rng.normal(size=G.shape[1]), rng.normal(size=(m, 4))
+    assert np.allclose(products.gradient(dU), (G @ dU).reshape(-1, 4), rtol=0, atol=1e-12 * abs(G @ dU).max())
+    f = internal_force(G, P, w, GT)
+    assert np.allclose(products.force(P), f, rtol=0, atol=1e-12 * abs(f).max())
 
 
 def test_what_it_cannot_do_is_refused() -> None:
     dx, dy = _gradients(2)
     G = gradient_operator(dx, dy)
-    assert PointwiseStiffness.build(G.tocsr().tobsr(blocksize=(4, 1)), None, np.ones(dx.shape[0])) is None
     w = np.ones(dx.shape[0])
-    corrector = PointwiseStiffness.build(G, None, w)
+    assert PointProducts.build(G.tocsr().tobsr(blocksize=(4, 1)), None, w) is None     # the FE layout
+    products = PointProducts.build(G, None, w)
     empty = sp.identity(G.shape[1], format="csr")        # a K_0 whose pattern lacks the coupling blocks
-    assert corrector.corrected(empty, np.array([0, 5]), np.ones((2, 3, 3))) is None
+    assert products.corrected(empty, np.array([0, 5]), np.ones((2, 3, 3))) is None
