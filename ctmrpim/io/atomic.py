@@ -6,10 +6,13 @@ and one that was killed leaves it behind for the next run in the folder to remov
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import re
+import signal
 import tempfile
-from collections.abc import Callable, Iterable
+import threading
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 #: the temporary name of a file NAME being written: mkstemp's random part has no dot
@@ -48,3 +51,32 @@ def leftovers(folder: Path, names: Iterable[str] | None = None) -> list[Path]:
         if m and p.is_file() and (wanted is None or m["name"] in wanted):
             found.append(p)
     return found
+
+
+@contextlib.contextmanager
+def signals_deferred() -> Iterator[None]:
+    """SIGINT and SIGTERM held back until the block is done, then handled as they would have been: for a write that
+    must not be cut in the middle. numpy's savez closes its archive in a ``finally`` that fails on an entry still
+    open, so Ctrl-C inside it ended a run with a ValueError (exit 1) instead of the interruption (exit 130), and
+    on older numpy left a ZipFile whose finaliser printed a traceback. Only in the main thread (the only one
+    where Python runs signal handlers); a signal whose handler was not set from Python is left alone."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[tuple[int, object]] = []
+    previous = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    previous = {s: h for s, h in previous.items() if h is not None}
+    for s in previous:
+        signal.signal(s, lambda signum, frame: caught.append((signum, frame)))
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+        if caught:
+            signum, frame = caught[0]
+            handler = previous[signum]
+            if callable(handler):
+                handler(signum, frame)
+            elif handler == signal.SIG_DFL:
+                signal.raise_signal(signum)

@@ -13,7 +13,6 @@ number is stored as ``{"float": "inf"}`` (or ``"-inf"``, ``"nan"``) and turned b
 """
 from __future__ import annotations
 
-import io
 import json
 import math
 from pathlib import Path
@@ -22,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ctmrpim.errors import ProblemError
-from ctmrpim.io.atomic import atomic_write
+from ctmrpim.io.atomic import atomic_write, signals_deferred
 from ctmrpim.io.summary import to_jsonable
 
 NAME = "checkpoint.npz"
@@ -60,14 +59,11 @@ def save_checkpoint(folder: Path, key: str, meta: dict[str, Any], arrays: dict[s
     payload["meta"] = np.array(json.dumps(_encode(to_jsonable({**meta, "key": key})), allow_nan=False))
 
     def write(tmp: Path) -> None:
-        # the archive is built in memory: a signal inside np.savez would otherwise leave its ZipFile open on a
-        # file the ``with`` has closed, and the ZipFile's finaliser prints a traceback at exit
-        buffer = io.BytesIO()
-        np.savez(buffer, **payload)
-        with open(tmp, "wb") as fh:
-            fh.write(buffer.getbuffer())
+        with open(tmp, "wb") as fh:          # a file object: np.savez would append ".npz" to a path
+            np.savez(fh, **payload)
 
-    atomic_write(path, write)
+    with signals_deferred():                 # Ctrl-C inside np.savez breaks its archive's close (atomic.py)
+        atomic_write(path, write)
     return path
 
 
