@@ -6,7 +6,8 @@ Newton-Raphson iterates on the strain increment from the last converged state,
     sigma = return_map(sigma_n, B (U - U_n)),   F_int = B^T (w sigma),   K = B^T diag(w D_ep) B,
 
 with D_ep the consistent tangent of the return map (:mod:`ctmrpim.materials.mohr_coulomb`),
-non-symmetric for a non-associated flow (psi < phi), so the linear solves use SuperLU. The history is
+non-symmetric for a non-associated flow (psi < phi), so the linear solves use LU factors (SuperLU, or a banded
+LU for CTM-RPIM's Newton tangents: :meth:`PlasticSystem._factorise`). The history is
 committed only when an increment converges; a cut-back restarts from the committed state.
 
 :class:`PlasticSystem` holds that equilibrium on any discretisation that supplies the gradient
@@ -227,7 +228,7 @@ class PlasticSystem:
         """du (2n,) with K du = ``residual`` (2n,) at the free dofs and du = 0 at the fixed ones, reusing the LU
         factors of K (2n x 2n) while K is unchanged.
 
-        The safeguard: a consistent tangent that SuperLU finds exactly singular, or whose step is not finite,
+        The safeguard: a consistent tangent whose LU finds a pivot exactly zero, or whose step is not finite,
         is replaced for this iteration by the elastic stiffness (:meth:`_safeguarded`); only a singular
         elastic stiffness is bad input (constraints that leave a rigid-body motion free)."""
         if K is self._K_elastic:          # factorised once, also between the re-check's Newton tangents
@@ -249,7 +250,7 @@ class PlasticSystem:
         return du
 
     def _factorise(self, K: sp.csr_matrix, banded: bool = True):
-        """SuperLU factors of K (2n x 2n) at the free dofs; RuntimeError where a pivot is exactly zero.
+        """LU factors of K (2n x 2n) at the free dofs; RuntimeError where a pivot is exactly zero.
 
         A row or column without a non-zero entry (dofs whose every point returned to the apex: D_ep = 0) is
         refused here, before SuperLU sees it: SuperLU's pivoting reads an uninitialised index on such a
