@@ -22,6 +22,8 @@ from ctmrpim.reference import elastica
 from studies.tip_load import MIN_STEPS
 
 L = 10.0
+#: seconds allowed on this 2-core machine (the seven loads are timed in one process here, after a warm-up)
+TARGETS = {"tip-load, seven loads": 20.0, "tip-load, largest load": 4.0, "ring": 10.0}
 
 
 def run(target: str, overrides: list[str]) -> tuple[dict, object]:
@@ -57,6 +59,7 @@ def main() -> None:
         print(f"tip-load P = {p:5g} kN: {row['wall_s']:6.2f} s, {row['increments']} increments, "
               f"{row['newton']} iterations, w/L {100 * row['w_rel_diff']:+.2f} % vs elastica", flush=True)
     tip_total = sum(r["wall_s"] for r in rows)
+    largest = rows[-1]["wall_s"]                             # the paper's largest load, lambda = 3.6
     row, r = run("end-moment", ["parameters.m=1.0", f"loading.steps={a.ring_steps}", *form])
     tip = r.probes["tip"]
     mid = np.abs(r.points[:, 1]) < 1e-9                      # the mid-line nodes
@@ -72,8 +75,10 @@ def main() -> None:
     df = pd.DataFrame(rows)
     pd.set_option("display.width", 250)
     print(df.round(3).to_string(index=False))
-    print(f"\n{a.formulation} (point_regeneration {a.point_regeneration:g}): tip-load, all seven levels {tip_total:.1f} s (target < 60 s); "
-          f"end-moment ring in {a.ring_steps} increments {row['wall_s']:.1f} s (target < 180 s); "
+    print(f"\n{a.formulation} (point_regeneration {a.point_regeneration:g}): tip-load, all seven levels "
+          f"{tip_total:.1f} s (target <= {TARGETS['tip-load, seven loads']:g} s), the largest alone "
+          f"{largest:.1f} s (target <= {TARGETS['tip-load, largest load']:g} s); "
+          f"end-moment ring in {a.ring_steps} increments {row['wall_s']:.1f} s (target <= {TARGETS['ring']:g} s); "
           f"{row['s_per_increment']:.2f} s per increment, {row['s_per_iteration']:.3f} s per Newton iteration")
     if a.csv:
         df.to_csv(a.csv, index=False)
