@@ -114,7 +114,7 @@ class LoadPath:
     cutbacks: int = 0
     newton_iterations: int = 0
     failed_at: float | None = None   # with ``stop_on_failure``: the load factor that did not converge
-    failed_trial: np.ndarray | None = None   # and the last Newton iterate there (the mechanism)
+    failed_trial: np.ndarray | None = None   # and the last iterate there (the first attempt's if the re-check failed)
 
 
 @dataclass
