@@ -20,6 +20,20 @@ def _run(kappa: float, recheck: bool = True, newton=None):
                       lambda t, U: {}, stop_on_failure=True, recheck=recheck, recheck_assemble=newton)
 
 
+def _tanh_body(U, t):
+    """f_int = tanh(u) under f_ext = 1.5 t, with its true tangent: no equilibrium at t = 1 (tanh < 1)."""
+    return np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[1.0 / np.cosh(np.clip(U[0], -50, 50)) ** 2 + 1e-12]])
+
+
+def _tanh_path(max_iterations: int):
+    """The tanh body iterated with the fixed 'stiffness' 2, re-checked by Newton on its true tangent."""
+    loading = Loading(steps=1, tolerance=1e-6, max_iterations=max_iterations, max_cutbacks=0)
+    return step_loads(1, loading, np.array([], int), np.array([]),
+                      lambda U, t: (np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[2.0]])),
+                      lambda K, r: r / K[0, 0], lambda t, U: {}, stop_on_failure=True, recheck=True,
+                      recheck_assemble=_tanh_body)
+
+
 def test_a_slow_but_steady_iteration_converges_on_the_recheck() -> None:
     """Contraction 0.98 per iteration needs about 680 iterations: more than twice the cap of 100, within the
     re-check's limit; the increment is carried and the history says it converged only on the re-check."""
@@ -53,13 +67,7 @@ def test_an_iteration_on_a_fixed_matrix_is_rechecked_by_newton() -> None:
 def test_newton_recheck_fails_a_body_without_equilibrium() -> None:
     """f_int = tanh(u) cannot carry f_ext = 1.5: Newton's re-check runs away (or reaches its cap) and the increment
     fails after at most RECHECK_LIMIT x NEWTON_ITERATIONS iterations."""
-    def assemble(U, t):
-        return np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[1.0 / np.cosh(np.clip(U[0], -50, 50)) ** 2 + 1e-12]])
-    loading = Loading(steps=1, tolerance=1e-6, max_iterations=100, max_cutbacks=0)
-    path = step_loads(1, loading, np.array([], int), np.array([]),
-                      lambda U, t: (np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[2.0]])),
-                      lambda K, r: r / K[0, 0], lambda t, U: {}, stop_on_failure=True, recheck=True,
-                      recheck_assemble=assemble)
+    path = _tanh_path(100)
     assert path.failed_at == 1.0
     assert path.history[-1]["iterations"] <= RECHECK_LIMIT * NEWTON_ITERATIONS
     assert "no convergence on the re-check (Newton" in path.history[-1]["note"]
@@ -68,13 +76,7 @@ def test_newton_recheck_fails_a_body_without_equilibrium() -> None:
 def test_a_failed_recheck_keeps_the_fixed_matrix_iterate_as_the_failed_state() -> None:
     """Where Newton's re-check runs away (f_int = tanh u under 1.5: its iterates grow without bound), the failed
     level's state is the fixed-matrix iteration's last iterate, a bounded field, not Newton's runaway one."""
-    def assemble(U, t):
-        return np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[1.0 / np.cosh(np.clip(U[0], -50, 50)) ** 2 + 1e-12]])
-    loading = Loading(steps=1, tolerance=1e-6, max_iterations=10, max_cutbacks=0)
-    path = step_loads(1, loading, np.array([], int), np.array([]),
-                      lambda U, t: (np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[2.0]])),
-                      lambda K, r: r / K[0, 0], lambda t, U: {}, stop_on_failure=True, recheck=True,
-                      recheck_assemble=assemble)
+    path = _tanh_path(10)
     assert path.failed_at == 1.0
     # ten plain steps of (1.5 - tanh u) / 2 from u = 0 stay below 10 * 1.5 / 2
     assert np.isfinite(path.failed_trial[0]) and abs(path.failed_trial[0]) < 7.5
