@@ -105,15 +105,29 @@ def resolve_case(spec: CaseSpec) -> tuple[Case, str]:
 _warm = False
 
 
+#: cases solved once per process before any timed one: the tiny one takes every method's small-size path (lazy
+#: imports, first-call set-up); the 65 x 17 cantilever is above the compiled thresholds of the shape functions,
+#: the assembly and the solve (``rpim.COMPILED_MIN_POINTS``, ``assembly.COMPILED_MIN_ENTRIES``), with the
+#: default (non-symmetric) and the paper's (symmetric) integration and the banded solver that larger clouds
+#: take, so that numba compiles or loads those kernels here and not inside the first large case: measured from
+#: an empty kernel cache, that case's wall time held 19-25 s of compilation (a 65 x 17 cantilever in 1.4 s
+#: counted as 31 s), which the time-to-accuracy and node density studies then reported as solver time.
+WARM_UP = ((("nodes.grid=[9, 3]",), (("ctm-rpim", None), ("fem", "q1"), ("fem", "p2"))),
+           (("nodes.grid=[65, 17]", 'method.solver="banded"'), (("ctm-rpim", None),)),
+           (("nodes.grid=[65, 17]", 'method.integration="ctm"', 'method.solver="banded"'), (("ctm-rpim", None),)))
+
+
 def _warm_up() -> None:
-    """Solve a tiny case with each method once per process, so that lazy imports and first-call
-    set-up costs stay out of the wall times the studies compare."""
+    """Solve the :data:`WARM_UP` cases once per process, so that lazy imports, first-call set-up and kernel
+    compilation stay out of the wall times the studies compare. The client calls it before it forks its local
+    workers, which then inherit the compiled kernels (compiled once, not once per worker)."""
     global _warm
     if _warm:
         return
-    tiny = load_case("cantilever", ["nodes.grid=[9, 3]"])
-    for solver, element in (("ctm-rpim", None), ("fem", "q1"), ("fem", "p2")):
-        solve(tiny, solver, element)
+    for overrides, methods in WARM_UP:
+        case = load_case("cantilever", list(overrides))
+        for solver, element in methods:
+            solve(case, solver, element)
     _warm = True
 
 
@@ -297,6 +311,11 @@ class Sweep:
                 # fork needs no `if __name__ == "__main__"` guard in the caller's script; the parent holds
                 # no threads of ours between cases (RPIM's pool lives only inside one call)
                 ctx = get_context("fork" if "fork" in get_all_start_methods() else "spawn")
+                if ctx.get_start_method() == "fork":   # the workers inherit what the warm-up compiled
+                    from threadpoolctl import threadpool_limits
+
+                    with threadpool_limits(1):
+                        _warm_up()
                 with ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_worker_setup) as pool:
                     futures = {pool.submit(run_case, *job, method_version(job[0].solver), str(self.folder(job[2]))): job
                                for job in jobs}

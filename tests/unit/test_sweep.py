@@ -86,3 +86,18 @@ def test_processes_and_in_process_agree(tmp_path) -> None:
     serial = Sweep(tmp_path / "a", progress=False).run(SPECS)
     parallel = Sweep(tmp_path / "b", workers=2, progress=False).run(SPECS)
     assert numbers(serial) == numbers(parallel)
+
+
+def test_warm_up_compiles_the_kernels_that_large_cases_take() -> None:
+    """The kernels above the compiled thresholds are compiled (or loaded) by the warm-up, before any timed case,
+    so that no case's wall time holds their compilation."""
+    from ctmrpim.discretisation import rpim_kernels, stiffness_kernels, vci_kernels
+    from studies import sweep
+
+    sweep._warm = False
+    sweep._warm_up()
+    kernels = (rpim_kernels.support_counts, rpim_kernels.rpim_rows, stiffness_kernels.row_counts,
+               stiffness_kernels.stiffness_rows, stiffness_kernels.mirror_lower, stiffness_kernels.constrained_csc,
+               stiffness_kernels.lower_bandwidth, stiffness_kernels.fill_lower_band, vci_kernels.moments,
+               vci_kernels.corrected)
+    assert [k.py_func.__name__ for k in kernels if not k.signatures] == []
