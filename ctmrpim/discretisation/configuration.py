@@ -141,15 +141,15 @@ class Configuration:
 def build(x: np.ndarray, boundary: Boundary, points: np.ndarray, w: np.ndarray, lengths: ScaledMethod, *,
           quadrature: Quadrature | None = None, active: np.ndarray | None = None,
           reference: tuple[np.ndarray, np.ndarray, float] | None = None, min_nodes: int = 0,
-          drop_singular: bool = False) -> Configuration:
+          drop_singular: bool = False, compiled_from: int | None = None) -> Configuration:
     """The RPIM shape functions of the nodes ``x`` (n, 2) at ``points`` (m, 2) with weights ``w`` (m,):
     a :class:`Configuration`. ``active`` limits the RPIM cloud to those nodes (the shape functions are
-    still indexed by all n); ``reference``, ``min_nodes`` and ``drop_singular`` are passed to
+    still indexed by all n); ``reference``, ``min_nodes``, ``drop_singular`` and ``compiled_from`` are passed to
     :func:`~ctmrpim.discretisation.rpim.shape_functions`."""
     cloud = x if active is None else x[active]
     tree = cKDTree(cloud)
     sf = shape_functions(cloud, points, tree=tree, reference=reference, min_nodes=min_nodes,
-                         drop_singular=drop_singular, **lengths.rpim())
+                         drop_singular=drop_singular, compiled_from=compiled_from, **lengths.rpim())
     if active is not None:
         shape = (len(points), len(x))
         N, dx, dy = (sp.csr_matrix((M.data, active[M.indices], M.indptr), shape=shape)

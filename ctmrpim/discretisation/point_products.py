@@ -1,4 +1,4 @@
-"""The Mohr-Coulomb system's products over the points, compiled, for CTM-RPIM's gradient operator.
+"""The Newton systems' products over the points, compiled, for CTM-RPIM's gradient operator.
 
 :class:`~ctmrpim.solvers.plastic_system.PlasticSystem` works on any G (4m x 2n); written with scipy, its three
 products run over G's 4 x 2 blocks, half of whose entries are zeros in the RPIM layout (one block
@@ -15,7 +15,9 @@ does them as compiled passes over (dN/dX, dN/dY) (:mod:`ctmrpim.discretisation.g
   thread pool; the points' pattern is transposed once.
 
 The CTM-RPIM solver hands them to the system (:mod:`ctmrpim.solvers.elastoplastic`); the finite-element reference's
-G (per-dof blocks) keeps the scipy products.
+G (per-dof blocks) keeps the scipy products. The updated-Lagrangian solver takes the full tangent
+sum_p w_p G~_p^T A_p G_p (A = dP/dF, 4 x 4 per point) from :meth:`PointProducts.tangent`
+(:func:`ctmrpim.discretisation.stiffness_kernels.tangent_rows`), half of it where it is symmetric.
 """
 from __future__ import annotations
 
@@ -35,7 +37,12 @@ class PointProducts:
         self.w = np.ascontiguousarray(w, dtype=float)
         self.n = trial.shape[1]
         self._transposed: tuple[np.ndarray, ...] | None = None
+        self._node_start: np.ndarray | None = None
         self.blocks = [(a, min(a + assembly.ROW_BLOCK, self.n)) for a in range(0, self.n, assembly.ROW_BLOCK)]
+        # the tangent is rebuilt every Newton iteration, also on small clouds: its rows in one block per thread there
+        size = min(assembly.ROW_BLOCK, max(1, -(-self.n // assembly.THREADS)))
+        self.tangent_blocks = [(a, min(a + size, self.n)) for a in range(0, self.n, size)]
+        self.sorted = _sorted_rows(trial.indptr, trial.indices)
 
     @classmethod
     def build(cls, G: sp.bsr_matrix, test: sp.bsr_matrix | None, w: np.ndarray) -> PointProducts | None:
@@ -60,11 +67,7 @@ class PointProducts:
         """K_0 (2n x 2n) + sum over ``points`` (k,) of w_p B~_p^T D_p B_p with ``D`` (k, 3, 3) in the engineering
         strain and stress (sxx, syy, sxy) of (exx, eyy, gxy); None where a block has no place in K_0's pattern."""
         tr = self.trial
-        if self._transposed is None:     # node -> (point, entry) lists of the points' pattern, once
-            etype = np.int32 if len(tr.indices) < 2**31 - 1 else np.int64
-            trow, tent = np.empty(len(tr.indices), etype), np.empty(len(tr.indices), etype)
-            tptr = kernels.transpose_pattern(tr.indptr, tr.indices, self.n, trow, tent)
-            self._transposed = (tptr, trow, tent)
+        transposed = self._transpose()
         slot = np.full(len(self.w), -1, np.int64)
         slot[points] = np.arange(len(points))
         Dc = np.ascontiguousarray(D, dtype=float)
@@ -73,8 +76,64 @@ class PointProducts:
 
         def rows(ab: tuple[int, int]) -> None:
             if not kernels.pointwise_rows(tr.indptr, tr.indices, tr.dx, tr.dy, self.tested.dx, self.tested.dy,
-                                          self.w, slot, Dc, *self._transposed, *ab, K.indptr, K.indices, K.data):
+                                          self.w, slot, Dc, *transposed, *ab, K.indptr, K.indices, K.data):
                 done[0] = False
 
         assembly.run_blocks(rows, self.blocks)
         return K if done[0] else None
+
+    def tangent(self, A: np.ndarray) -> sp.csr_matrix:
+        """K (2n x 2n) = sum_p w_p G~_p^T A_p G_p for A (m, 4, 4) or (m, 2, 2, 2, 2), dP/dF at the points: the
+        product of :func:`ctmrpim.solvers.weak_form.tangent` as a compiled pass node row by node row
+        (:func:`ctmrpim.discretisation.stiffness_kernels.tangent_rows`) instead of two sparse products over G's
+        half-empty 4 x 2 blocks. Its pattern is every pair of nodes that share a point, column indices sorted."""
+        tr, te = self.trial, self.tested
+        tptr, trow, tent = self._transpose()
+        if self._node_start is None:     # K's pattern sizes, once: the points and their supports do not change
+            counts = np.zeros(self.n, np.int64)
+            assembly.run_blocks(lambda ab: kernels.row_counts(tr.indptr, tr.indices, tptr, trow, self.n, *ab, counts),
+                                self.blocks)
+            self._node_start = np.zeros(self.n + 1, np.int64)
+            np.cumsum(counts, out=self._node_start[1:])
+        node_start = self._node_start
+        counts = np.diff(node_start)
+        nnz = 4 * int(node_start[-1])
+        itype = np.int32 if max(nnz, 2 * self.n) < 2**31 - 1 else np.int64
+        k_indices, k_data, k_indptr = np.empty(nnz, itype), np.empty(nnz), np.empty(2 * self.n + 1, itype)
+        k_indptr[0:-1:2] = 4 * node_start[:-1]
+        k_indptr[1::2] = 4 * node_start[:-1] + 2 * counts
+        k_indptr[-1] = nnz
+        Ac = np.ascontiguousarray(np.reshape(A, (len(self.w), 16)), dtype=float)
+        # symmetric K (Galerkin, every A_p symmetric: a hyperelastic dP/dF) on sorted rows: half the work
+        square = Ac.reshape(-1, 4, 4)
+        upper = te is tr and self.sorted and bool(np.array_equal(square, square.transpose(0, 2, 1)))
+        blocks = self.tangent_blocks
+        assembly.run_blocks(lambda ab: kernels.tangent_rows(tr.indptr, tr.indices, tr.dx, tr.dy, te.dx, te.dy, self.w,
+                                                            Ac, tptr, trow, tent, self.n, node_start, *ab, k_indices,
+                                                            k_data, upper), blocks)
+        if upper:
+            assembly.run_blocks(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks)
+        K = sp.csr_matrix((k_data, k_indices, k_indptr), shape=(2 * self.n, 2 * self.n), copy=False)
+        K.has_sorted_indices = True
+        K.has_canonical_format = True
+        return K
+
+    def _transpose(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """node -> (point, entry) lists of the points' pattern (:func:`kernels.transpose_pattern`), built once."""
+        if self._transposed is None:
+            tr = self.trial
+            etype = np.int32 if len(tr.indices) < 2**31 - 1 else np.int64
+            trow, tent = np.empty(len(tr.indices), etype), np.empty(len(tr.indices), etype)
+            tptr = kernels.transpose_pattern(tr.indptr, tr.indices, self.n, trow, tent)
+            self._transposed = (tptr, trow, tent)
+        return self._transposed
+
+
+def _sorted_rows(indptr: np.ndarray, indices: np.ndarray) -> bool:
+    """Whether the column indices increase within every row of a CSR pattern."""
+    if len(indices) < 2:
+        return True
+    step = np.diff(indices) > 0
+    starts = indptr[1:-1]                      # where a new row begins, the step from the last row does not count
+    step[starts[(starts > 0) & (starts < len(indices))] - 1] = True
+    return bool(step.all())

@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
-from threadpoolctl import threadpool_limits
 
+from ctmrpim.blas_threads import one_blas_thread
 from ctmrpim.discretisation import rpim_kernels as kernels
 from ctmrpim.errors import ProblemError
 
@@ -55,7 +55,8 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
                     polynomial_terms: int, scale: float, derivatives: bool = True,
                     tree: cKDTree | None = None,
                     reference: tuple[np.ndarray, np.ndarray, float] | None = None,
-                    min_nodes: int = 0, drop_singular: bool = False) -> ShapeFunctions:
+                    min_nodes: int = 0, drop_singular: bool = False,
+                    compiled_from: int | None = None) -> ShapeFunctions:
     """RPIM shape functions (Eqs. 25-34) of ``nodes`` at ``points``.
 
     ``support_radius`` and ``scale`` (d_c) are absolute lengths. A point whose support holds fewer
@@ -67,11 +68,14 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
     holds fewer nodes than that to its ``min_nodes`` nearest (a flow front, where the cloud thins out:
     r^eta with eta = 5 is conditionally positive definite of order 3, so with the linear basis a
     support of a handful of scattered nodes can make the moment matrix singular). ``tree``: a KD-tree
-    of ``nodes``, used only to widen supports (built here when needed and not given).
+    of ``nodes``, used only to widen supports (built here when needed and not given). ``compiled_from``: the
+    number of points from which the compiled kernels take over from numpy (None: :data:`COMPILED_MIN_POINTS`; a
+    caller that builds shape functions many times in one run pays numba's start once and may lower it; the choice
+    must follow from the input alone).
     """
     nodes = np.ascontiguousarray(nodes, dtype=float).reshape(-1, 2)
     points = np.ascontiguousarray(points, dtype=float).reshape(-1, 2)
-    if not kernels.use_compiled(len(points), COMPILED_MIN_POINTS):
+    if not kernels.use_compiled(len(points), COMPILED_MIN_POINTS if compiled_from is None else compiled_from):
         return _numpy_shape_functions(nodes, points, support_radius, eta, polynomial_terms, scale, derivatives,
                                       tree, reference, min_nodes, drop_singular)
     m = polynomial_terms
@@ -219,7 +223,7 @@ def _numpy_shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius
                       derivatives, ref, drop_singular)
 
     # each small LAPACK solve runs on one thread; BLAS threads on top of ours would only contend
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         if len(bounds) > 1 and THREADS > 1:
             with ThreadPoolExecutor(max_workers=THREADS) as pool:
                 parts = list(pool.map(work, bounds))

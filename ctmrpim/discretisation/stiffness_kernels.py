@@ -301,3 +301,78 @@ def pointwise_rows(indptr, indices, dx, dy, tdx, tdy, w, slot, D, tptr, trow, te
         for k in range(k_indptr[2 * i + 1], k_indptr[2 * i + 2]):
             pos1[k_indices[k]] = -1
     return True
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def tangent_rows(indptr, indices, dx, dy, tdx, tdy, w, A, tptr, trow, tent, n, node_start, r0, r1,
+                 k_indices, k_data, upper):
+    """Rows 2I and 2I + 1 of K = sum_p w_p G~_p^T A_p G_p for r0 <= I < r1, in the layout of :func:`stiffness_rows`
+    (node row I owns 4 node_start[I] .. 4 node_start[I + 1], columns 2J, 2J + 1 for J ascending): A (m, 16) the
+    point's dP/dF (row 4p + c, c = 2i + J for du_i/dX_J: xX, xY, yX, yY) flattened row-major, (dx, dy) the trial
+    and (tdx, tdy) the test gradients on the pattern (indptr, indices):
+    K[(I, i), (K, k)] = sum_p w_p sum_JL d~N_I/dX_J A[2i + J, 2k + L] dN_K/dX_L. ``upper``: K symmetric (test =
+    trial, every A_p symmetric, the pattern's rows sorted): only the blocks K >= I are summed and written, as in
+    :func:`stiffness_rows`; :func:`mirror_lower` writes the rest."""
+    mark = np.full(n, -1, np.int64)
+    pos = np.empty(n, np.int64)
+    width = 0
+    for i in range(r0, r1):
+        width = max(width, node_start[i + 1] - node_start[i])
+    cols = np.empty(width, np.int64)
+    b00 = np.empty(width)
+    b01 = np.empty(width)
+    b10 = np.empty(width)
+    b11 = np.empty(width)
+    for i in range(r0, r1):
+        c = 0
+        for t in range(tptr[i], tptr[i + 1]):
+            p = trow[t]
+            for k in range(indptr[p], indptr[p + 1]):
+                j = indices[k]
+                if mark[j] != i:
+                    mark[j] = i
+                    cols[c] = j
+                    c += 1
+        cs = np.sort(cols[:c])
+        for q in range(c):
+            pos[cs[q]] = q
+            b00[q] = 0.0
+            b01[q] = 0.0
+            b10[q] = 0.0
+            b11[q] = 0.0
+        for t in range(tptr[i], tptr[i + 1]):
+            p = trow[t]
+            e = tent[t]
+            ax = tdx[e] * w[p]
+            ay = tdy[e] * w[p]
+            # v_ikL = sum_J a_J A[2i + J, 2k + L]: rows 0, 1 (i = x) and 2, 3 (i = y) of A, columns 2k + L
+            v000 = ax * A[p, 0] + ay * A[p, 4]
+            v001 = ax * A[p, 1] + ay * A[p, 5]
+            v010 = ax * A[p, 2] + ay * A[p, 6]
+            v011 = ax * A[p, 3] + ay * A[p, 7]
+            v100 = ax * A[p, 8] + ay * A[p, 12]
+            v101 = ax * A[p, 9] + ay * A[p, 13]
+            v110 = ax * A[p, 10] + ay * A[p, 14]
+            v111 = ax * A[p, 11] + ay * A[p, 15]
+            for k in range(e if upper else indptr[p], indptr[p + 1]):
+                q = pos[indices[k]]
+                bx = dx[k]
+                by = dy[k]
+                b00[q] += v000 * bx + v001 * by
+                b01[q] += v010 * bx + v011 * by
+                b10[q] += v100 * bx + v101 * by
+                b11[q] += v110 * bx + v111 * by
+        o0 = 4 * node_start[i]
+        o1 = o0 + 2 * c
+        for q in range(c):
+            j = cs[q]
+            k_indices[o0 + 2 * q] = 2 * j
+            k_indices[o0 + 2 * q + 1] = 2 * j + 1
+            k_indices[o1 + 2 * q] = 2 * j
+            k_indices[o1 + 2 * q + 1] = 2 * j + 1
+            if upper and j < i:
+                continue
+            k_data[o0 + 2 * q] = b00[q]
+            k_data[o0 + 2 * q + 1] = b01[q]
+            k_data[o1 + 2 * q] = b10[q]
+            k_data[o1 + 2 * q + 1] = b11[q]

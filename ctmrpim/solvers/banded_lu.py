@@ -29,7 +29,8 @@ import numpy as np
 import scipy.linalg.lapack as lapack
 import scipy.sparse as sp
 from scipy.sparse.csgraph import reverse_cuthill_mckee
-from threadpoolctl import threadpool_limits
+
+from ctmrpim.blas_threads import one_blas_thread
 
 #: the band is taken where its half-width is at most this many times the free block's entries per row
 MAX_BAND_PER_ROW = 2.0
@@ -87,7 +88,7 @@ class BandedLU:
         """The factors of K's free block; RuntimeError where a pivot is exactly zero (as SuperLU's)."""
         band = np.zeros((self.n, self.rows))
         band.ravel()[self.place] = K.data[self.take]
-        with threadpool_limits(1):     # OpenBLAS's threads spin-wait for a busy core (linear_solver's note)
+        with one_blas_thread():     # OpenBLAS's threads spin-wait for a busy core (linear_solver's note)
             lub, piv, info = lapack.dgbtrf(band.T, self.kl, self.ku, overwrite_ab=1)
         if info > 0:
             raise RuntimeError("Factor is exactly singular")

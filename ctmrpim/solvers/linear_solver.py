@@ -36,8 +36,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import reverse_cuthill_mckee
-from threadpoolctl import threadpool_limits
 
+from ctmrpim.blas_threads import one_blas_thread
 from ctmrpim.discretisation import assembly, rpim_kernels, stiffness_kernels
 from ctmrpim.errors import ProblemError
 
@@ -70,7 +70,7 @@ def solve_free(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, U: np.ndarra
                solver: str = "superlu", symmetric: bool = True) -> np.ndarray:
     """U with U[free] solving Kff U[free] = rhs (:func:`constrained_system`), by ``solver`` (``symmetric``:
     whether Kff is)."""
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         U[free] = _solve(Kff, rhs, solver, symmetric)
     if not np.all(np.isfinite(U)):
         raise ProblemError("the linear solve produced non-finite displacements: the stiffness matrix is singular")

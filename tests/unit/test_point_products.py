@@ -52,6 +52,36 @@ def test_the_compiled_products_equal_the_sparse_products(petrov: bool) -> None:
     assert np.allclose(products.force(P), f, rtol=0, atol=1e-12 * abs(f).max())
 
 
+@pytest.mark.parametrize("petrov, symmetric", [(False, False), (True, False), (False, True), (True, True)])
+def test_the_compiled_tangent_equals_the_sparse_product(petrov: bool, symmetric: bool) -> None:
+    """G~^T diag(w A) G with a full 4 x 4 A per point (the large-deformation tangents; a symmetric one, as
+    hyperelasticity gives, takes the half-work path where the test gradients are the trial ones), every entry to
+    round-off, on the pattern of the node pairs that share a point (sorted columns)."""
+    dx, dy = _gradients(4)
+    G = gradient_operator(dx, dy)
+    test = None
+    if petrov:
+        rng = np.random.default_rng(8)
+        test = gradient_operator(sp.csr_matrix((rng.normal(size=dx.nnz), dx.indices, dx.indptr), shape=dx.shape),
+                                 sp.csr_matrix((rng.normal(size=dx.nnz), dx.indices, dx.indptr), shape=dx.shape))
+    m = dx.shape[0]
+    rng = np.random.default_rng(5)
+    w = rng.uniform(0.5, 1.5, m)
+    A = rng.normal(size=(m, 4, 4))
+    if symmetric:
+        A = A + A.transpose(0, 2, 1)
+    products = PointProducts.build(G, test, w)
+    expected = tangent(G, A, w, G.T if test is None else test.T)
+    for _ in range(2):        # the second call re-uses the pattern built by the first
+        K = products.tangent(A)
+        assert K.has_sorted_indices and np.all(np.diff(K.indices[K.indptr[0]:K.indptr[1]]) > 0)
+        assert abs(K - expected).max() <= 1e-12 * abs(expected).max()
+    if symmetric and not petrov:
+        assert abs(K - K.T).max() <= 1e-14 * abs(K).max()     # the mirrored half (a node's own block summed)
+    pairs = (abs(dx.T) @ abs(dx)).tocsr()          # the node pairs that share a point
+    assert K.nnz == 4 * pairs.nnz
+
+
 def test_what_it_cannot_do_is_refused() -> None:
     dx, dy = _gradients(2)
     G = gradient_operator(dx, dy)
