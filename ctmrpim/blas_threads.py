@@ -3,8 +3,8 @@
 ``threadpoolctl.threadpool_limits`` finds the BLAS libraries by scanning the process's memory maps on every
 call: 2-3 ms, paid on every linear solve of a Newton iteration (116 calls took 0.4 s of a 5.8 s tip-load run,
 7 %). A :class:`threadpoolctl.ThreadpoolController` made once holds what it found; its ``limit`` sets and
-restores the thread counts alone. It is made at the first call, when numpy's and scipy's BLAS are loaded
-(the callers import scipy.linalg at their own import).
+restores the thread counts alone. It is made at the first call; scipy.linalg is imported here first, so that
+scipy's BLAS is loaded beside numpy's before the controller looks.
 """
 from __future__ import annotations
 
