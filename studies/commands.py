@@ -22,6 +22,12 @@ def _sweep(args: argparse.Namespace):
     return Sweep(CACHE, workers=args.workers, scheduler=args.scheduler, retry_failed=args.retry_failed)
 
 
+def _out(args: argparse.Namespace, quick: bool) -> Path:
+    """The folder for tables and figures: ``--out``, else ``reports/`` in quick mode and ``reports/full/`` in full
+    mode (where the committed full-mode results and their provenance live)."""
+    return Path(args.out) if args.out is not None else Path("reports") if quick else Path("reports") / "full"
+
+
 def cmd_study(args: argparse.Namespace) -> int:
     """``ctmrpim study NAME|all``: run the study (or every one) and print its table without the JSON columns; exit
     status 0, a ProblemError for an unknown name."""
@@ -35,7 +41,7 @@ def cmd_study(args: argparse.Namespace) -> int:
                                f"available: {', '.join(studies.ALIASES)} or all")
     sweep = _sweep(args)
     for name in names:
-        df = studies.run(name, args.quick, Path(args.out), sweep)
+        df = studies.run(name, args.quick, _out(args, args.quick), sweep)
         shown = df.drop(columns=[c for c in df if c == "status" or df[c].astype(str).str.startswith(("{", "[")).any()
                                  or c == "folder"])      # curves and profiles (JSON) stay in the CSV
         print(shown.to_string(index=False))
@@ -46,13 +52,14 @@ def cmd_report(args: argparse.Namespace) -> int:
     """``ctmrpim report``: regenerate the verification report (quick unless ``--full``); exit status 0."""
     from studies.report import make_report
 
-    path = make_report(quick=not args.full, out_dir=Path(args.out), sweep=_sweep(args))
+    path = make_report(quick=not args.full, out_dir=_out(args, not args.full), sweep=_sweep(args))
     print(f"wrote {path}")
     return 0
 
 
 def _sweep_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", default="reports", help="folder for tables and figures (default reports/)")
+    p.add_argument("--out", help="folder for tables and figures (default reports/ in quick mode, reports/full/ "
+                                  "in full mode)")
     p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                    help="local worker processes for the sweeps (default: one per core; 1 runs in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run the sweeps on this Dask scheduler instead")

@@ -132,5 +132,5 @@ def write_provenance(w: Writer, out_dir: Path) -> None:
     w(md(pd.DataFrame(rows)) + "\n\n")
     stale = [r["study"] for r in rows if r["state"] != "current"]
     if stale:
-        w(f"Not current: {', '.join(stale)}; `ctmrpim study NAME --out reports/full` re-runs one (full mode) and "
+        w(f"Not current: {', '.join(stale)}; `ctmrpim study NAME` re-runs one (full mode) and "
           "stamps it anew.\n\n")
