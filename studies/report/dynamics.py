@@ -279,9 +279,9 @@ def measured_height() -> float:
     return float(measured_surface()[0, 1])
 
 
-def write_full_mode_notes(w: Writer, out_dir: Path) -> None:
+def write_full_mode_notes(w: Writer, out_dir: Path, with_figures: bool = True) -> None:
     """What the full runs measured, read from the committed full-mode tables under ``out_dir/full``, with their
-    figures."""
+    figures unless ``with_figures`` is false (a full report, which shows them in its own sections)."""
     w("### Full mode (measured)\n\n")
     cc, vs, st = (full_rows(out_dir, n) for n in FULL_STUDIES)
     w("Read from the full-mode tables committed under `reports/full/` (`ctmrpim study column-collapse --out "
@@ -301,6 +301,6 @@ def write_full_mode_notes(w: Writer, out_dir: Path) -> None:
         _viscosity_notes(w, vs)
     if st is not None:
         _settings_notes(w, st)
-    for name in FULL_STUDIES:
+    for name in FULL_STUDIES if with_figures else ():
         if (out_dir / "full" / f"{name}.png").exists():
             w(f"![{name.replace('_', ' ')}, full mode](full/{name}.png)\n\n")
