@@ -131,7 +131,15 @@ def _warm_up() -> None:
     _warm = True
 
 
-def _worker_setup() -> None:
+def warm_up_for_fork() -> None:
+    """:func:`_warm_up` on one BLAS thread, before forking workers that are to inherit what it compiled."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(1):
+        _warm_up()
+
+
+def one_core_worker() -> None:
     """A worker process computes on one core: one RPIM thread (BLAS is limited per case)."""
     from ctmrpim.discretisation import rpim
 
@@ -184,7 +192,7 @@ def _solve_into(spec: CaseSpec, case: Case, folder: Path, status: dict[str, Any]
     from threadpoolctl import threadpool_limits
 
     if worker:
-        _worker_setup()
+        one_core_worker()
     with threadpool_limits(1):
         _warm_up()
     try:
@@ -331,11 +339,8 @@ class Sweep:
                 # no threads of ours between cases (RPIM's pool lives only inside one call)
                 ctx = get_context("fork" if "fork" in get_all_start_methods() else "spawn")
                 if ctx.get_start_method() == "fork":   # the workers inherit what the warm-up compiled
-                    from threadpoolctl import threadpool_limits
-
-                    with threadpool_limits(1):
-                        _warm_up()
-                with ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=_worker_setup) as pool:
+                    warm_up_for_fork()
+                with ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=one_core_worker) as pool:
                     futures = {pool.submit(run_case, *job, method_version(job[0].solver), str(self.folder(job[2]))): job
                                for job in jobs}
                     for fut in as_completed(futures):

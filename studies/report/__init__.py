@@ -15,7 +15,6 @@ from pathlib import Path
 
 import studies
 from ctmrpim.io.atomic import atomic_write_text
-from studies import explicit_conservation
 from studies.base import CACHE
 from studies.integration_schemes import scheme_table
 from studies.report import dynamics, full_figures, large_deformation, linear, models, stability, summary
@@ -23,6 +22,7 @@ from studies.report.checks import all_checks, claims_table, console_summary
 from studies.report.fe_references import write_fe_references
 from studies.report.markdown import Progress
 from studies.report.nonlinear_schemes import write_nonlinear_schemes
+from studies.report.side_runs import SideRuns, study_tables
 from studies.sweep import Sweep
 from studies.time_to_accuracy import targets_table
 
@@ -39,8 +39,15 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     # the end of each; the studies then read their cases from the cache
     cases = [spec for name in studies.NAMES for spec in studies.study(name).specs(quick)]
     progress(f"all studies ({'quick' if quick else 'full'}): {len(cases)} cases")
-    sweep.run(cases, desc="all studies")
-    tables = {name: studies.run(name, quick, out_dir, sweep, progress) for name in studies.NAMES}
+    with SideRuns(quick, out_dir, parallel=sweep.workers > 1 and not sweep.scheduler) as side:
+        sweep.run(cases, desc="all studies")
+        tables = study_tables(quick, out_dir, sweep, progress)
+        _write(quick, out_dir, tables, side, progress)
+    return out_dir / "REPORT.md"
+
+
+def _write(quick: bool, out_dir: Path, tables: dict, side: SideRuns, progress: Progress) -> None:
+    """Write ``out_dir/REPORT.md`` from the studies' ``tables`` and the ``side`` runs' results; print the checks."""
     # the sections that quote the committed full-mode results read ``root/full``: beside a quick report
     # (``reports/full``), and in a full one (written to ``reports/full``) the tables this run has just written there
     root = out_dir if quick else out_dir.parent
@@ -52,7 +59,8 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     summary.write_claims(w, claim_rows, tables)
     summary.write_accuracy_checks(w, checks)
     summary.write_provenance(w, root)
-    models.write_models(w, quick, out_dir, progress)
+    side.result("models", progress)
+    models.write_models(w)
     linear.write_node_density(w, tables["node_density"])
     linear.write_time_to_accuracy(w, targets_table(tables["time_to_accuracy"]))
     linear.write_parameter_studies(w, tables)
@@ -61,17 +69,18 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     write_fe_references(w, tables["fe_references"])
     large_deformation.write_tip_load(w, tables["tip_load"], tables["fe_references"], out_dir if quick else None)
     large_deformation.write_end_moment(w, tables["end_moment"], out_dir if quick else None)
-    large_deformation.write_deformed_shapes(w, quick, out_dir, progress)
+    side.result("deformed_shapes", progress)
+    large_deformation.write_deformed_shapes(w)
     stability.write_side_by_side(w, tables["slope_stability"], tables["footing_bearing"])
     stability.write_slope_stability(w, tables["slope_stability"], out_dir if quick else None)
     stability.write_srf_sweep(w, tables["slope_srf_sweep"])
     stability.write_relaxation(w, tables["slope_relaxation"])
     stability.write_footing(w, tables["footing_bearing"], out_dir if quick else None)
-    stability.write_stability_fields(w, quick, out_dir, progress)
+    side.result("stability_fields", progress)
+    stability.write_stability_fields(w)
     stability.write_slope_slide(w, tables["slope_slide"])
     dynamics.write_column_collapse(w, tables["column_collapse"], quick)
-    progress("explicit_conservation: momentum of a free flight and a spin, ctm and ctm-vci")
-    flights, operators = explicit_conservation.measure(quick)
+    flights, operators = side.result("explicit_conservation", progress)
     atomic_write_text(out_dir / "explicit_conservation.csv", flights.to_csv(index=False))
     atomic_write_text(out_dir / "explicit_conservation_operators.csv", operators.to_csv(index=False))
     dynamics.write_momentum_conservation(w, flights, operators, tables["column_collapse"])
@@ -81,8 +90,6 @@ def make_report(quick: bool = True, out_dir: Path = Path("reports"), sweep: Swee
     if quick:
         full_figures.write_full_figures(w, out_dir)
     write_nonlinear_schemes(w, tables["nonlinear_schemes"])
-    path = out_dir / "REPORT.md"
-    atomic_write_text(path, buf.getvalue())
+    atomic_write_text(out_dir / "REPORT.md", buf.getvalue())
     progress("\n" + console_summary(checks, claim_rows))
-    return path
 

@@ -15,7 +15,7 @@ from ctmrpim.reference.elastica import tip_load_elliptic
 from studies import deformed_shapes, tolerances
 from studies.fe_references import converged_table, converged_tip_load
 from studies.report.full_results import full_table
-from studies.report.markdown import Progress, Writer, md, sci, span
+from studies.report.markdown import Writer, md, sci, span
 
 
 def write_tip_load(w: Writer, tip: pd.DataFrame, fe: pd.DataFrame | None = None,
@@ -149,8 +149,8 @@ def _full_figure(w: Writer, out_dir: Path | None, name: str, state: str, what: s
           f"![{name.replace('_', ' ')}, full mode](full/{name}.png)\n\n")
 
 
-def write_deformed_shapes(w: Writer, quick: bool, out_dir: Path, progress: Progress) -> None:
-    """Runs the deformed-shapes figure (Figs. 15 and 17) and writes its section."""
-    deformed_shapes.run(quick, out_dir, progress)
+def write_deformed_shapes(w: Writer) -> None:
+    """The section of the deformed-shapes figure (Figs. 15 and 17), which :func:`studies.deformed_shapes.run`
+    draws."""
     w(f"### Deformed configurations (cf. Figs. 15 and 17)\n\n{deformed_shapes.__doc__.strip()}\n\n"
       f"![deformed shapes](deformed_shapes.png)\n\n")

@@ -15,7 +15,7 @@ from ctmrpim import benchmarks
 from studies import stability_fields, tolerances
 from studies.footing_bearing import PRANDTL
 from studies.report.full_results import full_table
-from studies.report.markdown import Progress, Writer, md, pct, span
+from studies.report.markdown import Writer, md, pct, span
 
 
 def _finest(df: pd.DataFrame, method: str) -> pd.Series | None:
@@ -421,9 +421,9 @@ def write_footing_full(w: Writer, full: pd.DataFrame, state: str) -> None:
     w("\n\n")
 
 
-def write_stability_fields(w: Writer, quick: bool, out_dir: Path, progress: Progress) -> None:
-    """Runs the stability fields figure (Figs. 20 and 25) and writes its section."""
-    stability_fields.run(quick, out_dir, progress)
+def write_stability_fields(w: Writer) -> None:
+    """The section of the stability fields figure (Figs. 20 and 25), which :func:`studies.stability_fields.run`
+    draws."""
     w(f"### Fields (cf. Figs. 20 and 25)\n\n{stability_fields.__doc__.strip()}\n\n"
       "![stability fields](stability_fields.png)\n\n")
 
