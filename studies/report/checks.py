@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ctmrpim import benchmarks
 from studies import claims, provenance, tolerances
 from studies.column_collapse import FINAL
 from studies.fitting import fitted_rate
@@ -72,8 +73,6 @@ def pinned_slopes(slopes: pd.DataFrame) -> pd.DataFrame:
     flow rule, tangent and cap; the other variants are sensitivities the stability section reports) at the node
     spacing of its benchmark file, the cloud the pins are stated for, where the table holds it (a full run); a
     quick run's coarser clouds where it does not."""
-    from ctmrpim import benchmarks
-
     ok = slopes[slopes.status == "ok"]
     if "variant" in ok:
         ok = ok[ok.variant == "default"]

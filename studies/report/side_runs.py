@@ -13,6 +13,7 @@ runs happen here, one after another, as before.
 from __future__ import annotations
 
 from concurrent.futures import Future, ProcessPoolExecutor
+from dataclasses import dataclass
 from multiprocessing import get_all_start_methods, get_context
 from pathlib import Path
 from typing import Any, Callable
@@ -21,46 +22,46 @@ import pandas as pd
 
 import studies
 from studies import deformed_shapes, explicit_conservation, model_figures, stability_fields
+from studies.provenance import stamp
 from studies.report.markdown import Progress
 from studies.sweep import Sweep, one_core_worker, warm_up_for_fork
 
-#: the runs that need fields, by name: ``(quick, out_dir, progress) -> result``, longest first
-RUNS: dict[str, Callable[[bool, Path, Progress], Any]] = {
-    "deformed_shapes": deformed_shapes.run,
-    "stability_fields": stability_fields.run,
-    "explicit_conservation": lambda quick, out_dir, progress: _conservation(quick, progress),
-    "models": model_figures.run,
-}
+
+@dataclass(frozen=True)
+class SideRun:
+    """One of the report's runs that need fields: ``run(quick, out_dir, progress) -> result``, and the files it
+    writes (``NAME.csv`` / ``NAME.png`` for each NAME of ``files``) with the ``studies`` module that makes them,
+    which a full report stamps like the studies' results (:func:`studies.provenance.stamp`)."""
+    run: Callable[[bool, Path, Progress], Any]
+    module: str
+    files: tuple[str, ...]
 
 
-#: the files (``NAME.csv`` / ``NAME.png``) each run writes, and the ``studies`` module that makes them: a full
-#: report stamps them like the studies' results (:func:`studies.provenance.stamp`)
-OUTPUTS: dict[str, tuple[str, tuple[str, ...]]] = {
-    "deformed_shapes": ("deformed_shapes", ("deformed_shapes",)),
-    "stability_fields": ("stability_fields", ("stability_fields",)),
-    "explicit_conservation": ("explicit_conservation", ("explicit_conservation", "explicit_conservation_operators")),
-    "models": ("model_figures", ("alpha_shapes", "models")),
+def _conservation_run(quick: bool, out_dir: Path, progress: Progress) -> tuple[pd.DataFrame, pd.DataFrame]:
+    progress("explicit_conservation: momentum of a free flight and a spin, ctm and ctm-vci")
+    return explicit_conservation.measure(quick)
+
+
+#: the runs that need fields, by name, longest first
+RUNS: dict[str, SideRun] = {
+    "deformed_shapes": SideRun(deformed_shapes.run, "deformed_shapes", ("deformed_shapes",)),
+    "stability_fields": SideRun(stability_fields.run, "stability_fields", ("stability_fields",)),
+    "explicit_conservation": SideRun(_conservation_run, "explicit_conservation",
+                                     ("explicit_conservation", "explicit_conservation_operators")),
+    "models": SideRun(model_figures.run, "model_figures", ("alpha_shapes", "models")),
 }
 
 
 def stamp_outputs(name: str, out_dir: Path) -> None:
     """Stamp the files of run ``name`` in ``out_dir`` with the code that made them (a full report's)."""
-    from studies.provenance import stamp
-
-    module, files = OUTPUTS[name]
-    for stem in files:
-        stamp(out_dir, stem, module=module)
-
-
-def _conservation(quick: bool, progress: Progress) -> tuple[pd.DataFrame, pd.DataFrame]:
-    progress("explicit_conservation: momentum of a free flight and a spin, ctm and ctm-vci")
-    return explicit_conservation.measure(quick)
+    for stem in RUNS[name].files:
+        stamp(out_dir, stem, module=RUNS[name].module)
 
 
 def _run(name: str, quick: bool, out_dir: Path) -> tuple[Any, list[str]]:
     """Run :data:`RUNS` ``name``; its result and its progress lines."""
     lines: list[str] = []
-    return RUNS[name](quick, out_dir, lines.append), lines
+    return RUNS[name].run(quick, out_dir, lines.append), lines
 
 
 def _table(name: str, quick: bool, out_dir: Path, sweep: Sweep) -> tuple[pd.DataFrame, list[str]]:

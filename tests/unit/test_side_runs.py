@@ -16,7 +16,9 @@ def _fake_runs(quick, out_dir, progress):
 
 @pytest.fixture
 def fake(monkeypatch):
-    monkeypatch.setattr(side_runs, "RUNS", {"first": _fake_runs, "second": lambda q, o, p: (p("second"), 42)[1]})
+    monkeypatch.setattr(side_runs, "RUNS", {"first": side_runs.SideRun(_fake_runs, "demo", ("first",)),
+                                           "second": side_runs.SideRun(lambda q, o, p: (p("second"), 42)[1], "demo",
+                                                                       ("second",))})
     monkeypatch.setattr(side_runs, "warm_up_for_fork", lambda: None)   # no solver needed here
 
 
@@ -36,7 +38,7 @@ def test_a_side_run_that_fails_raises_in_the_report(monkeypatch, tmp_path) -> No
     def broken(quick, out_dir, progress):
         raise ValueError("no field")
 
-    monkeypatch.setattr(side_runs, "RUNS", {"broken": broken})
+    monkeypatch.setattr(side_runs, "RUNS", {"broken": side_runs.SideRun(broken, "demo", ("broken",))})
     monkeypatch.setattr(side_runs, "warm_up_for_fork", lambda: None)
     with side_runs.SideRuns(True, tmp_path, parallel=True) as side, pytest.raises(ValueError, match="no field"):
         side.result("broken", print)
