@@ -254,7 +254,8 @@ def stamp(out_dir: Path, study: str, commit: str | None = None, root: Path = ROO
         found = [ln.split("=", 1)[1].strip().strip("\"'") for ln in version.splitlines()
                  if ln.startswith("__version__ =")]
     record = {"study": study, **({"module": module} if module else {}), "mode": "full", "files": files,
-              "ctmrpim_version": found[0] if found else None, "git_commit": head, "numerics_differ_from_commit": dirty, "made_by": made,
+              "ctmrpim_version": found[0] if found else None, "git_commit": head,
+              "numerics_differ_from_commit": dirty, "made_by": made,
               "stamped": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"), "sources": sources}
     path = sidecar(out_dir, study)
     path.write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")

@@ -131,8 +131,9 @@ def _warm_up() -> None:
     _warm = True
 
 
-def warm_up_for_fork() -> None:
-    """:func:`_warm_up` on one BLAS thread, before forking workers that are to inherit what it compiled."""
+def warm_up() -> None:
+    """:func:`_warm_up` on one BLAS thread: in each process that times cases, and in the client before it forks
+    workers, which then inherit what it compiled."""
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(1):
@@ -193,8 +194,7 @@ def _solve_into(spec: CaseSpec, case: Case, folder: Path, status: dict[str, Any]
 
     if worker:
         one_core_worker()
-    with threadpool_limits(1):
-        _warm_up()
+    warm_up()
     try:
         with threadpool_limits(1):
             result = solve(case, spec.solver, spec.element, out=folder,   # explicit runs: series, checkpoints
@@ -339,7 +339,7 @@ class Sweep:
                 # no threads of ours between cases (RPIM's pool lives only inside one call)
                 ctx = get_context("fork" if "fork" in get_all_start_methods() else "spawn")
                 if ctx.get_start_method() == "fork":   # the workers inherit what the warm-up compiled
-                    warm_up_for_fork()
+                    warm_up()
                 with ProcessPoolExecutor(self.workers, mp_context=ctx, initializer=one_core_worker) as pool:
                     futures = {pool.submit(run_case, *job, method_version(job[0].solver), str(self.folder(job[2]))): job
                                for job in jobs}

@@ -284,8 +284,8 @@ def write_full_mode_notes(w: Writer, out_dir: Path, with_figures: bool = True) -
     figures unless ``with_figures`` is false (a full report, which shows them in its own sections)."""
     w("### Full mode (measured)\n\n")
     cc, vs, st = (full_rows(out_dir, n) for n in FULL_STUDIES)
-    w("Read from the full-mode tables committed under `reports/full/` (`ctmrpim study column-collapse --out "
-      "reports/full`, the same for `column-collapse-viscosity` and `column-collapse-settings`).\n\n")
+    w("Read from the full-mode tables committed under `reports/full/` (`ctmrpim study column-collapse`, the "
+      "same for `column-collapse-viscosity` and `column-collapse-settings`).\n\n")
     if cc is None and vs is None and st is None:
         w("No full-mode table is present: nothing to quote.\n\n")
     states = {n: provenance.status(Path(out_dir) / "full", n) for n in FULL_STUDIES

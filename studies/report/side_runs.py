@@ -24,7 +24,7 @@ import studies
 from studies import deformed_shapes, explicit_conservation, model_figures, stability_fields
 from studies.provenance import stamp
 from studies.report.markdown import Progress
-from studies.sweep import Sweep, one_core_worker, warm_up_for_fork
+from studies.sweep import Sweep, one_core_worker, warm_up
 
 
 @dataclass(frozen=True)
@@ -83,7 +83,7 @@ def _pool(workers: int) -> ProcessPoolExecutor | None:
     workers would import and compile everything again: not worth it for these runs)."""
     if "fork" not in get_all_start_methods():
         return None
-    warm_up_for_fork()
+    warm_up()
     return ProcessPoolExecutor(workers, mp_context=get_context("fork"), initializer=_one_core)
 
 

@@ -19,7 +19,7 @@ def fake(monkeypatch):
     monkeypatch.setattr(side_runs, "RUNS", {"first": side_runs.SideRun(_fake_runs, "demo", ("first",)),
                                            "second": side_runs.SideRun(lambda q, o, p: (p("second"), 42)[1], "demo",
                                                                        ("second",))})
-    monkeypatch.setattr(side_runs, "warm_up_for_fork", lambda: None)   # no solver needed here
+    monkeypatch.setattr(side_runs, "warm_up", lambda: None)   # no solver needed here
 
 
 @pytest.mark.parametrize("parallel", [False, True])
@@ -39,6 +39,6 @@ def test_a_side_run_that_fails_raises_in_the_report(monkeypatch, tmp_path) -> No
         raise ValueError("no field")
 
     monkeypatch.setattr(side_runs, "RUNS", {"broken": side_runs.SideRun(broken, "demo", ("broken",))})
-    monkeypatch.setattr(side_runs, "warm_up_for_fork", lambda: None)
+    monkeypatch.setattr(side_runs, "warm_up", lambda: None)
     with side_runs.SideRuns(True, tmp_path, parallel=True) as side, pytest.raises(ValueError, match="no field"):
         side.result("broken", print)
