@@ -1,4 +1,5 @@
-"""Banded LU (LAPACK dgbtrf) of tangents that share one sparsity pattern: the Mohr-Coulomb Newton iteration's.
+"""Banded LU (LAPACK dgbtrf) of tangents that share one sparsity pattern: the Mohr-Coulomb Newton iteration's, and
+the updated-Lagrangian iteration's within one configuration.
 
 Newton on the consistent tangent factorises a new matrix every iteration, always on the elastic stiffness's
 pattern (the plastic correction couples the nodes that already share a point). SuperLU orders and analyses each

@@ -65,6 +65,7 @@ from ctmrpim.materials.objective_stress import (
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.settings import ScaledMethod
 from ctmrpim.result import Result, probe_record
+from ctmrpim.solvers.banded_lu import BandedLU
 from ctmrpim.solvers.linear_solver import solve_constrained
 from ctmrpim.solvers.load_stepping import step_loads
 from ctmrpim.solvers.weak_form import internal_force, tangent
@@ -354,7 +355,8 @@ class AdaptiveBody:
     def step_output(self) -> dict[str, np.ndarray]:
         """A series step's nodal output on the current configuration: ``u``, ``stress``, ``stress_zz``, the tracked
         ``boundary`` edges and the ``triangles`` of the body inside them."""
-        return {"u": self.u, "stress": self.stress_nodes(), "stress_zz": self.stress_zz_nodes(),
+        stress = self._nodal_stress()      # one projection for the in-plane and the out-of-plane stress
+        return {"u": self.u, "stress": stress[:, :3], "stress_zz": stress[:, 3],
                 "boundary": self.boundary.edges.copy(), "triangles": self.boundary.triangles.copy()}
 
 
@@ -402,7 +404,22 @@ def solve_updated_lagrangian(case: Case) -> Result:
     fixed, fixed_values = tags.fixed, tags.fixed_values
     series: list[dict] = []
 
+    free = np.setdiff1d(np.arange(2 * n), fixed)
+    bands: list[BandedLU] = []
+
     def solve(K, residual):   # the rate-form and follower tangents are not symmetric
+        # a configuration's tangents share its pattern (the points and their supports): the band's layout is
+        # found once per configuration, each tangent is one gather and one banded LU (banded_lu.py)
+        if not (bands and bands[0].fits(K)):
+            bands[:] = [BandedLU(K, free)]
+        if bands[0].worthwhile:
+            du = np.zeros_like(residual)
+            try:
+                du[free] = bands[0].factorise(K).solve(residual[free])
+            except RuntimeError as exc:
+                raise ProblemError(f"the tangent stiffness is singular ({exc}): the constraints do not prevent "
+                                   "rigid-body motion, or part of the body is detached") from None
+            return du
         return solve_constrained(K, residual, fixed, np.zeros(len(fixed)), "superlu")
 
     def probe_values() -> dict:
