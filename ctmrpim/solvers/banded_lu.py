@@ -96,3 +96,4 @@ class BandedLU:
         if info < 0:
             raise ValueError(f"dgbtrf: illegal argument {-info}")
         return BandedFactors(lub, piv, self.kl, self.ku, self.perm)
+

@@ -65,9 +65,8 @@ from ctmrpim.materials.objective_stress import (
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.settings import ScaledMethod
 from ctmrpim.result import Result, probe_record
-from ctmrpim.solvers.banded_lu import BandedLU
-from ctmrpim.solvers.linear_solver import solve_constrained
 from ctmrpim.solvers.load_stepping import step_loads
+from ctmrpim.solvers.pattern_solver import PatternSolver
 from ctmrpim.solvers.weak_form import internal_force, tangent
 from ctmrpim.timing import Timer
 
@@ -404,23 +403,8 @@ def solve_updated_lagrangian(case: Case) -> Result:
     fixed, fixed_values = tags.fixed, tags.fixed_values
     series: list[dict] = []
 
-    free = np.setdiff1d(np.arange(2 * n), fixed)
-    bands: list[BandedLU] = []
-
-    def solve(K, residual):   # the rate-form and follower tangents are not symmetric
-        # a configuration's tangents share its pattern (the points and their supports): the band's layout is
-        # found once per configuration, each tangent is one gather and one banded LU (banded_lu.py)
-        if not (bands and bands[0].fits(K)):
-            bands[:] = [BandedLU(K, free)]
-        if bands[0].worthwhile:
-            du = np.zeros_like(residual)
-            try:
-                du[free] = bands[0].factorise(K).solve(residual[free])
-            except RuntimeError as exc:
-                raise ProblemError(f"the tangent stiffness is singular ({exc}): the constraints do not prevent "
-                                   "rigid-body motion, or part of the body is detached") from None
-            return du
-        return solve_constrained(K, residual, fixed, np.zeros(len(fixed)), "superlu")
+    # the rate-form and follower tangents are not symmetric; a configuration's tangents share its pattern
+    solve = PatternSolver(2 * n, fixed)
 
     def probe_values() -> dict:
         u = body.material_x[:len(probes_X)] - probes_X
