@@ -231,27 +231,30 @@ def sidecar(out_dir: Path, study: str) -> Path:
     return Path(out_dir) / f"{study}{SUFFIX}"
 
 
-def stamp(out_dir: Path, study: str, commit: str | None = None, root: Path = ROOT) -> Path:
+def stamp(out_dir: Path, study: str, commit: str | None = None, root: Path = ROOT, module: str | None = None) -> Path:
     """Write the sidecar of ``study``'s result in ``out_dir``: made by the working tree at ``root`` (the default),
-    or, for a result made before stamping existed, by the sources committed in ``commit``; its path."""
+    or, for a result made before stamping existed, by the sources committed in ``commit``; its path. ``module``:
+    the ``studies`` module that made the files ``NAME.csv`` / ``NAME.png`` where it is not ``studies/NAME.py``
+    (the full report's own figures and tables, :mod:`studies.report.side_runs`)."""
     out_dir = Path(out_dir)
     files = {f"{study}{s}": _sha((out_dir / f"{study}{s}").read_bytes()) for s in OUTPUTS
              if (out_dir / f"{study}{s}").is_file()}
+    maker = module or study
     if commit is None:
-        sources = fingerprint(study, root)
+        sources = fingerprint(maker, root)
         head = (_git("rev-parse", "HEAD", root=root) or "").strip() or None
         dirty = bool(head and (_git("status", "--porcelain", "--", *sources, root=root) or "").strip())
         made = "the working tree at the time of the run"
         found = [__version__]
     else:
         head = (_git("rev-parse", commit, root=root) or commit).strip()
-        sources, dirty = fingerprint_at(study, head, root), False
+        sources, dirty = fingerprint_at(maker, head, root), False
         made = "stamped after the run: the sources of the commit that committed the result"
         version = "".join(_git("show", f"{head}:ctmrpim/{f}", root=root) or "" for f in ("version.py", "__init__.py"))
         found = [ln.split("=", 1)[1].strip().strip("\"'") for ln in version.splitlines()
                  if ln.startswith("__version__ =")]
-    record = {"study": study, "mode": "full", "files": files, "ctmrpim_version": found[0] if found else None,
-              "git_commit": head, "numerics_differ_from_commit": dirty, "made_by": made,
+    record = {"study": study, **({"module": module} if module else {}), "mode": "full", "files": files,
+              "ctmrpim_version": found[0] if found else None, "git_commit": head, "numerics_differ_from_commit": dirty, "made_by": made,
               "stamped": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"), "sources": sources}
     path = sidecar(out_dir, study)
     path.write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")
@@ -301,7 +304,7 @@ def status(out_dir: Path, study: str, root: Path = ROOT) -> Status:
     rec = json.loads(path.read_text())
     rewritten = [n for n, h in rec["files"].items()
                  if not (Path(out_dir) / n).is_file() or _sha((Path(out_dir) / n).read_bytes()) != h]
-    now, then = fingerprint(study, root), rec["sources"]
+    now, then = fingerprint(rec.get("module", study), root), rec["sources"]
     changed = sorted(f for f in set(now) | set(then) if now.get(f) != then.get(f))
     state = "modified" if rewritten else "stale" if changed or rec.get("numerics_differ_from_commit") else "current"
     return Status(study, state, rec.get("git_commit"), rec.get("ctmrpim_version"), changed, rewritten)

@@ -17,7 +17,7 @@ import studies
 from ctmrpim.io.atomic import atomic_write_text
 from studies.base import CACHE
 from studies.integration_schemes import scheme_table
-from studies.report import dynamics, full_figures, large_deformation, linear, models, stability, summary
+from studies.report import dynamics, full_figures, large_deformation, linear, models, side_runs, stability, summary
 from studies.report.checks import all_checks, claims_table, console_summary
 from studies.report.fe_references import write_fe_references
 from studies.report.markdown import Progress
@@ -90,6 +90,9 @@ def _write(quick: bool, out_dir: Path, tables: dict, side: SideRuns, progress: P
     if quick:
         full_figures.write_full_figures(w, out_dir)
     write_nonlinear_schemes(w, tables["nonlinear_schemes"])
+    if not quick:   # the full report's own figures and tables carry their provenance like the studies' results
+        for name in side_runs.RUNS:
+            side_runs.stamp_outputs(name, out_dir)
     atomic_write_text(out_dir / "REPORT.md", buf.getvalue())
     progress("\n" + console_summary(checks, claim_rows))
 

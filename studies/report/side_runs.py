@@ -33,6 +33,25 @@ RUNS: dict[str, Callable[[bool, Path, Progress], Any]] = {
 }
 
 
+#: the files (``NAME.csv`` / ``NAME.png``) each run writes, and the ``studies`` module that makes them: a full
+#: report stamps them like the studies' results (:func:`studies.provenance.stamp`)
+OUTPUTS: dict[str, tuple[str, tuple[str, ...]]] = {
+    "deformed_shapes": ("deformed_shapes", ("deformed_shapes",)),
+    "stability_fields": ("stability_fields", ("stability_fields",)),
+    "explicit_conservation": ("explicit_conservation", ("explicit_conservation", "explicit_conservation_operators")),
+    "models": ("model_figures", ("alpha_shapes", "models")),
+}
+
+
+def stamp_outputs(name: str, out_dir: Path) -> None:
+    """Stamp the files of run ``name`` in ``out_dir`` with the code that made them (a full report's)."""
+    from studies.provenance import stamp
+
+    module, files = OUTPUTS[name]
+    for stem in files:
+        stamp(out_dir, stem, module=module)
+
+
 def _conservation(quick: bool, progress: Progress) -> tuple[pd.DataFrame, pd.DataFrame]:
     progress("explicit_conservation: momentum of a free flight and a spin, ctm and ctm-vci")
     return explicit_conservation.measure(quick)

@@ -143,3 +143,19 @@ def test_every_committed_full_mode_result_is_stamped() -> None:
     for name in provenance.studies_in(full):
         s = provenance.status(full, name)
         assert s.state in ("current", "stale"), f"{name}: {s.state} ({s.describe()})"
+
+
+def test_a_result_named_apart_from_its_module_follows_that_modules_sources(tmp_path: Path) -> None:
+    """The full report's own files (e.g. ``alpha_shapes.png`` by ``studies/model_figures.py``) are stamped with the
+    module that made them, and go stale with its sources, not with a study of their name."""
+    root, out = tmp_path / "repo", tmp_path / "full"
+    _tree(root)
+    out.mkdir()
+    (out / "pictures.png").write_bytes(b"\x89PNG fake")
+    provenance.stamp(out, "pictures", root=root, module="demo")
+    record = json.loads(provenance.sidecar(out, "pictures").read_text())
+    assert record["module"] == "demo" and set(record["files"]) == {"pictures.png"}
+    assert "studies/helper.py" in record["sources"]          # demo's import, followed
+    assert provenance.status(out, "pictures", root).state == "current"
+    (root / "studies/helper.py").write_text("z = 5\n")
+    assert provenance.status(out, "pictures", root).state == "stale"
