@@ -99,6 +99,34 @@ def _return(s1, s2, s3, G, K, c, sphi, cphi, spsi):
 
 
 @njit(cache=True)
+def _trial_and_return(r0, r1, r2, r3, e0, e1, e2, lam, G, K, c, sphi, cphi, spsi):
+    """The elastic trial stress from (r0, r1, r2, r3) (xx, yy, xy, zz) and the strain increment (e0, e1, e2) (exx,
+    eyy, gxy; ezz = 0), returned to the yield surface where it lies outside (MohrCoulomb._update): the new stress
+    and the return region (0: elastic)."""
+    tr = e0 + e1
+    t0 = r0 + lam * tr + 2.0 * G * e0
+    t1 = r1 + lam * tr + 2.0 * G * e1
+    t2 = r2 + G * e2
+    t3 = r3 + lam * tr
+    s1, s2, s3, nx, ny, zslot = _sorted_principal(t0, t1, t2, t3)
+    fy = (s1 - s3) + (s1 + s3) * sphi - 2.0 * c * cphi
+    reg = 0
+    if fy > YIELD_TOL * (c + max(abs(s1), abs(s2), abs(s3))):
+        s1, s2, s3, reg = _return(s1, s2, s3, G, K, c, sphi, cphi, spsi)
+        if zslot == 0:
+            szz, big, small = s1, s2, s3
+        elif zslot == 1:
+            szz, big, small = s2, s1, s3
+        else:
+            szz, big, small = s3, s1, s2
+        t0 = big * nx * nx + small * ny * ny
+        t1 = big * ny * ny + small * nx * nx
+        t2 = (big - small) * nx * ny
+        t3 = szz
+    return t0, t1, t2, t3, reg
+
+
+@njit(cache=True)
 def _update(f, stress, plastic, viscous, dead, w, G, K, c, sphi, cphi, spsi, E, nu, beta_dt, out_stress, out_plastic,
             out_viscous, region):
     lam = K - 2.0 * G / 3.0
@@ -124,27 +152,7 @@ def _update(f, stress, plastic, viscous, dead, w, G, K, c, sphi, cphi, spsi, E, 
         out_viscous[p, 2] = beta_dt * G * e2
         out_viscous[p, 3] = beta_dt * lam * tr
         viscous_work += w[p] * (viscous[p, 0] * e0 + viscous[p, 1] * e1 + viscous[p, 2] * e2)
-        # elastic trial and the return (MohrCoulomb._update)
-        t0 = r0 + lam * tr + 2.0 * G * e0
-        t1 = r1 + lam * tr + 2.0 * G * e1
-        t2 = r2 + G * e2
-        t3 = r3 + lam * tr
-        s1, s2, s3, nx, ny, zslot = _sorted_principal(t0, t1, t2, t3)
-        fy = (s1 - s3) + (s1 + s3) * sphi - 2.0 * c * cphi
-        big_abs = max(abs(s1), abs(s2), abs(s3))
-        reg = 0
-        if fy > YIELD_TOL * (c + big_abs):
-            s1, s2, s3, reg = _return(s1, s2, s3, G, K, c, sphi, cphi, spsi)
-            if zslot == 0:
-                szz, big, small = s1, s2, s3
-            elif zslot == 1:
-                szz, big, small = s2, s1, s3
-            else:
-                szz, big, small = s3, s1, s2
-            t0 = big * nx * nx + small * ny * ny
-            t1 = big * ny * ny + small * nx * nx
-            t2 = (big - small) * nx * ny
-            t3 = szz
+        t0, t1, t2, t3, reg = _trial_and_return(r0, r1, r2, r3, e0, e1, e2, lam, G, K, c, sphi, cphi, spsi)
         region[p] = reg
         out_stress[p, 0], out_stress[p, 1], out_stress[p, 2], out_stress[p, 3] = t0, t1, t2, t3
         # plastic strain increment: total (ezz = 0) less C (sigma_new - sigma_rotated)
@@ -192,27 +200,8 @@ def point_update(material: MohrCoulomb, f: np.ndarray, stress: np.ndarray, plast
 def _small_strain(stress, de, G, K, c, sphi, cphi, spsi, out, region):
     lam = K - 2.0 * G / 3.0
     for p in range(stress.shape[0]):
-        e0, e1, e2 = de[p, 0], de[p, 1], de[p, 2]
-        tr = e0 + e1
-        t0 = stress[p, 0] + lam * tr + 2.0 * G * e0
-        t1 = stress[p, 1] + lam * tr + 2.0 * G * e1
-        t2 = stress[p, 2] + G * e2
-        t3 = stress[p, 3] + lam * tr
-        s1, s2, s3, nx, ny, zslot = _sorted_principal(t0, t1, t2, t3)
-        fy = (s1 - s3) + (s1 + s3) * sphi - 2.0 * c * cphi
-        reg = 0
-        if fy > YIELD_TOL * (c + max(abs(s1), abs(s2), abs(s3))):
-            s1, s2, s3, reg = _return(s1, s2, s3, G, K, c, sphi, cphi, spsi)
-            if zslot == 0:
-                szz, big, small = s1, s2, s3
-            elif zslot == 1:
-                szz, big, small = s2, s1, s3
-            else:
-                szz, big, small = s3, s1, s2
-            t0 = big * nx * nx + small * ny * ny
-            t1 = big * ny * ny + small * nx * nx
-            t2 = (big - small) * nx * ny
-            t3 = szz
+        t0, t1, t2, t3, reg = _trial_and_return(stress[p, 0], stress[p, 1], stress[p, 2], stress[p, 3], de[p, 0],
+                                                de[p, 1], de[p, 2], lam, G, K, c, sphi, cphi, spsi)
         region[p] = reg
         out[p, 0], out[p, 1], out[p, 2], out[p, 3] = t0, t1, t2, t3
 

@@ -19,7 +19,7 @@ from ctmrpim.errors import ProblemError
 
 POLYNOMIAL_TERMS = {"linear": 3, "quadratic": 6}
 BOUNDARIES = ("alpha", "geometry")
-LINEAR_SOLVERS = ("auto", "banded", "superlu", "spsolve")
+LINEAR_SOLVERS = ("auto", "banded", "superlu", "spsolve", "pardiso", "amg")
 #: large-deformation (quasi-static) formulations: the paper's adaptive one, and the cross-check
 FORMULATIONS = ("updated-lagrangian", "total-lagrangian")
 #: integration schemes: the paper's CTM, CTM with variationally consistent test gradients (VCI), and two
@@ -83,7 +83,7 @@ class Method:
     gauss_points: int = 1                # Gauss points per sub-segment and per band
     alpha: float = 1.5                   # alpha-shape radius / d_c
     boundary: str = "alpha"              # integrate over the tracked alpha shape, or the exact geometry
-    solver: str = "auto"                 # linear solver: auto, banded (RCM + Cholesky), superlu, spsolve
+    solver: str = "auto"                 # linear solver: auto, banded (RCM + Cholesky), superlu, spsolve, pardiso, amg
     match_tolerance: float = 0.01        # '==' tolerance in `where` selectors / d_c
     formulation: str = "updated-lagrangian"  # quasi-static: the paper's adaptive one, or total-lagrangian
     point_regeneration: float = 0.0      # UL: lay new CTM points once a point is strained by more than

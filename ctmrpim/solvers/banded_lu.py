@@ -1,4 +1,5 @@
-"""Banded LU (LAPACK dgbtrf) of tangents that share one sparsity pattern: the Mohr-Coulomb Newton iteration's.
+"""Banded LU (LAPACK dgbtrf) of tangents that share one sparsity pattern: the Mohr-Coulomb Newton iteration's, and
+the updated-Lagrangian iteration's within one configuration.
 
 Newton on the consistent tangent factorises a new matrix every iteration, always on the elastic stiffness's
 pattern (the plastic correction couples the nodes that already share a point). SuperLU orders and analyses each
@@ -95,3 +96,4 @@ class BandedLU:
         if info < 0:
             raise ValueError(f"dgbtrf: illegal argument {-info}")
         return BandedFactors(lub, piv, self.kl, self.ku, self.perm)
+

@@ -91,7 +91,7 @@ def solve_ctmrpim(case: Case) -> Result:
     n_dofs, k_nnz = K.shape[0], int(K.nnz)
     system = constrained_system(K, F, fixed, fixed_values)
     del K     # one copy of the stiffness (the free block) while it is factorised
-    U = solve_free(*system, method.solver, symmetric)
+    U = solve_free(*system, method.solver, symmetric, nodes)
     del system
     u = U.reshape(-1, 2)
     timer.lap("solve", free_dofs=n_dofs - len(fixed))

@@ -65,8 +65,8 @@ from ctmrpim.materials.objective_stress import (
 from ctmrpim.problem.case import Case
 from ctmrpim.problem.settings import ScaledMethod
 from ctmrpim.result import Result, probe_record
-from ctmrpim.solvers.linear_solver import solve_constrained
 from ctmrpim.solvers.load_stepping import step_loads
+from ctmrpim.solvers.pattern_solver import PatternSolver
 from ctmrpim.solvers.weak_form import internal_force, tangent
 from ctmrpim.timing import Timer
 
@@ -354,7 +354,8 @@ class AdaptiveBody:
     def step_output(self) -> dict[str, np.ndarray]:
         """A series step's nodal output on the current configuration: ``u``, ``stress``, ``stress_zz``, the tracked
         ``boundary`` edges and the ``triangles`` of the body inside them."""
-        return {"u": self.u, "stress": self.stress_nodes(), "stress_zz": self.stress_zz_nodes(),
+        stress = self._nodal_stress()      # one projection for the in-plane and the out-of-plane stress
+        return {"u": self.u, "stress": stress[:, :3], "stress_zz": stress[:, 3],
                 "boundary": self.boundary.edges.copy(), "triangles": self.boundary.triangles.copy()}
 
 
@@ -402,8 +403,8 @@ def solve_updated_lagrangian(case: Case) -> Result:
     fixed, fixed_values = tags.fixed, tags.fixed_values
     series: list[dict] = []
 
-    def solve(K, residual):   # the rate-form and follower tangents are not symmetric
-        return solve_constrained(K, residual, fixed, np.zeros(len(fixed)), "superlu")
+    # the rate-form and follower tangents are not symmetric; a configuration's tangents share its pattern
+    solve = PatternSolver(2 * n, fixed)
 
     def probe_values() -> dict:
         u = body.material_x[:len(probes_X)] - probes_X

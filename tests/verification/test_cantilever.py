@@ -86,7 +86,14 @@ def test_geometry_boundary_gives_same_answer_on_a_rectangle(solved) -> None:
     assert r.probes["tip"]["uy"] == pytest.approx(solved[33, 9].probes["tip"]["uy"], rel=1e-12)
 
 
-@pytest.mark.parametrize("solver", ["banded", "superlu", "spsolve"])
+def _optional(solver: str):
+    from ctmrpim.solvers.linear_solver import OPTIONAL, available
+
+    return pytest.param(solver, marks=pytest.mark.skipif(not available(solver), reason=f"{OPTIONAL[solver]} is not "
+                                                         "installed (pip install -e '.[solvers]'; CI installs it)"))
+
+
+@pytest.mark.parametrize("solver", ["banded", "superlu", "spsolve", _optional("pardiso"), _optional("amg")])
 @pytest.mark.parametrize("scheme", ["paper", "default"])
 def test_linear_solvers_agree(solved, default, solver: str, scheme: str) -> None:
     reference, extra = (solved, [PAPER]) if scheme == "paper" else (default, [])

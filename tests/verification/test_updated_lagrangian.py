@@ -87,3 +87,17 @@ def test_carried_points_keep_their_state(summaries) -> None:
 def test_points_are_laid_anew_once_strained_past_the_threshold() -> None:
     r = solve(benchmarks.load("tip-load", ["parameters.lam=1.2", "loading.steps=6", UL, "method.point_regeneration=0.02"]))
     assert r.counts["rebuilds"] == 5 and 0 < r.counts["state_transfers"] < 5
+
+
+def test_banded_newton_solve_gives_superlus_iterates(monkeypatch) -> None:
+    """The Newton tangents factorised in their configuration's band (banded LU with partial pivoting, the
+    non-symmetric rate-form tangent as it is) give SuperLU's answer: same iterations, tip to round-off."""
+    from ctmrpim.solvers import banded_lu
+
+    overrides = ["parameters.m=0.125", "loading.steps=4", UL]
+    banded = solve(benchmarks.load("end-moment", overrides))
+    monkeypatch.setattr(banded_lu, "MAX_BAND_PER_ROW", 0.0)     # no band is worthwhile: SuperLU throughout
+    superlu = solve(benchmarks.load("end-moment", overrides))
+    assert banded.counts["newton_iterations"] == superlu.counts["newton_iterations"]
+    tip_b, tip_s = (np.array([r.probes["tip"]["ux"], r.probes["tip"]["uy"]]) for r in (banded, superlu))
+    assert np.abs(tip_b - tip_s).max() <= 1e-9 * np.abs(tip_s).max()
