@@ -51,9 +51,10 @@ CRITERION = {"newton": "displacement runaway or non-convergence: a level is fail
                        "strength-reduction.limit_growth times the largest displacement at SRF = start (the response: "
                        "the SRF-displacement curve turning flat), or when the equilibrium iteration (loading.tangent: "
                        "Newton, or the elastic stiffness with Anderson mixing) does not reach the residual and "
-                       "displacement tolerance at an SRF sub-step cut back loading.max_cutbacks times, re-checked before it "
-                       "counts (by Newton on the consistent tangent where the iteration was the elastic stiffness's, "
-                       "with 8 times its cap)",
+                       "displacement tolerance at an SRF sub-step cut back loading.max_cutbacks times (where the iteration is "
+                       "the elastic stiffness's, every sub-step it does not converge is handed over to Newton on the "
+                       "consistent tangent before it is cut back), re-checked before it counts (by Newton on the "
+                       "consistent tangent where the iteration was the elastic stiffness's, with 8 times its cap)",
              "dynamic-relaxation": "still moving: after dynamic.steps steps of dynamic relaxation the out-of-balance "
                                    "force is above dynamic.tolerance of the loads and the maximum displacement grew "
                                    "by more than 1 % over the last quarter of the steps (the paper's criterion: it "
@@ -185,6 +186,7 @@ def search(system, loading: Loading, material: MohrCoulomb, settings: StrengthRe
             if reached.stable:
                 stable = reached
             else:                 # it ran away already: the level beyond is failed at least as much
+                reached.iterations, reached.cutbacks, reached.seconds = level.iterations, level.cutbacks, level.seconds
                 failed = reached
                 continue
         if level.stable:

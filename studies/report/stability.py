@@ -193,7 +193,9 @@ def write_slope_stability(w: Writer, sl: pd.DataFrame, out_dir: Path | None = No
       f"sigma_zz and reaches the yield surface below {depth:.1f} m of cover, from the benchmark's c, phi and unit "
       "weight); there full Newton wanders for tens of iterations, so the slopes iterate on the elastic stiffness "
       "(factorised once for the whole search) with Anderson-mixed steps (`loading.tangent = \"elastic\"`, see "
-      "`ctmrpim/solvers/plastic_system.py`).\n\n")
+      "`ctmrpim/solvers/plastic_system.py`); a sub-step that iteration does not converge goes to Newton on the "
+      "consistent tangent from its last iterate before it is cut back, so near the limit Newton, not the "
+      "elastic iteration's patience, decides (`ctmrpim/solvers/load_stepping.py`).\n\n")
 
 
 def write_slope_full(w: Writer, full: pd.DataFrame, state: str) -> None:

@@ -80,3 +80,23 @@ def test_a_failed_recheck_keeps_the_fixed_matrix_iterate_as_the_failed_state() -
     assert path.failed_at == 1.0
     # ten plain steps of (1.5 - tanh u) / 2 from u = 0 stay below 10 * 1.5 / 2
     assert np.isfinite(path.failed_trial[0]) and abs(path.failed_trial[0]) < 7.5
+
+
+def test_a_non_converged_increment_is_handed_over_to_newton_before_a_cut_back() -> None:
+    """With cut-backs left, an increment the fixed-matrix iteration does not converge goes to Newton from its last
+    iterate first: where Newton converges, the increment is carried without a cut-back and the history says how;
+    where it cannot (no equilibrium), the increment is cut back as before."""
+    exact = sp.csr_matrix([[1.0]])
+    loading = Loading(steps=1, tolerance=1e-6, max_iterations=100, max_cutbacks=2)
+    path = step_loads(1, loading, np.array([], int), np.array([]),
+                      lambda U, t: (np.array([t]), U.copy(), sp.csr_matrix([[1e5]])), lambda K, r: r / K[0, 0],
+                      lambda t, U: {}, stop_on_failure=True, recheck=True,
+                      recheck_assemble=lambda U, t: (np.array([t]), U.copy(), exact))
+    assert path.failed_at is None and path.cutbacks == 0 and np.isclose(path.U[0], 1.0, rtol=1e-9)
+    assert "converged by Newton on the consistent tangent" in path.history[-1]["note"]
+    without = Loading(steps=1, tolerance=1e-6, max_iterations=10, max_cutbacks=2)
+    failing = step_loads(1, without, np.array([], int), np.array([]),
+                         lambda U, t: (np.array([1.5 * t]), np.tanh(U), sp.csr_matrix([[2.0]])),
+                         lambda K, r: r / K[0, 0], lambda t, U: {}, stop_on_failure=True, recheck=True,
+                         recheck_assemble=_tanh_body)
+    assert failing.cutbacks == 2 and failing.failed_at is not None
