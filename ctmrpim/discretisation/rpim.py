@@ -44,7 +44,7 @@ PARTITION_OF_UNITY_TOL = 1e-6  # sum_i phi_i - 1 beyond this means the moment ma
 @dataclass
 class ShapeFunctions:
     """RPIM shape functions (Eqs. 25-34) of n nodes at m points: sparse rows (point -> support nodes)."""
-    N: sp.csr_matrix        # (m, n) values
+    N: sp.csr_matrix        # (m, n) values (a linear solve drops them once its loads are built)
     dNdx: sp.csr_matrix     # (m, n) x derivatives
     dNdy: sp.csr_matrix     # (m, n) y derivatives
     support_sizes: np.ndarray  # (m,) nodes in each point's support

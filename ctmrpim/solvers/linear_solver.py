@@ -8,7 +8,7 @@ Solvers (``method.solver``):
 * ``superlu``: SuperLU with the MMD_AT_PLUS_A ordering; measured, it is 4-6 times faster than scipy's
   default COLAMD ordering on these stiffness matrices (docs/design.md, 'Linear solvers').
 * ``banded``: reverse Cuthill-McKee ordering, then LAPACK's banded Cholesky (K is symmetric positive
-  definite once constrained). On elongated bodies such as the cantilever the band is narrow and this
+  definite once constrained; in mixed precision, below). On elongated bodies such as the cantilever the band is narrow and this
   wins: 0.48 s against 0.76 s for SuperLU at 129 x 33 nodes, measured here.
 * ``auto`` (default): ``banded`` when the band is at most BANDED_MAX_FRACTION of the dofs, else
   ``pardiso`` where pypardiso is installed and there are at least PARDISO_MIN_DOFS free dofs, else
@@ -29,11 +29,14 @@ Solvers (``method.solver``):
 
 A non-symmetric K (the consistent schemes' Dirichlet terms and corrected test gradients) takes, under
 ``auto`` or ``banded``, GMRES preconditioned by the banded Cholesky factor of its symmetric part, where that
-part is positive definite and its band narrow, else SuperLU. The two differ by little (a few per cent in the
-corrected gradients), so GMRES stops in about 12 iterations at a relative residual of 1e-11 (SuperLU's
-is 2-5e-12 on these systems, 2e-12 the floor); measured on the 129 x 33 cantilever's default K: 0.41 s CPU against 0.68 s
-for SuperLU, solutions equal to 1e-11 relative. It is refused (SuperLU instead) unless the true residual
-reaches GMRES_RTOL within GMRES_RESTART x GMRES_CYCLES iterations.
+part is positive definite and its band narrow, else SuperLU.
+
+Either band is factorised in single precision first
+(half the memory and time; the band is the largest array of a large solve) and used as the preconditioner of
+conjugate gradients (symmetric K) or GMRES, with iterative refinement on the double-precision residual to
+KRYLOV_RTOL (1e-11; SuperLU's is 2-5e-12 on these systems); where that factor breaks down or does not bring the
+residual there, the double-precision band: the factor itself for a symmetric K, the preconditioner again for a
+non-symmetric one (docs/design.md, 'Linear solvers', with the measurements).
 
 The factorisations run on one BLAS thread: on this project's two-core machine, with other work running, the
 banded Cholesky of the 129 x 33 cantilever took 4.6 s on OpenBLAS's default threads against 0.73 s on one
@@ -46,6 +49,7 @@ from typing import Callable
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.linalg.lapack as lapack
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import reverse_cuthill_mckee
@@ -55,10 +59,14 @@ from ctmrpim.discretisation import assembly, rpim_kernels, stiffness_kernels
 from ctmrpim.errors import ProblemError
 
 BANDED_MAX_FRACTION = 0.1   # auto: banded Cholesky when the RCM half-bandwidth is at most this share of the dofs
-GMRES_RTOL = 1e-11          # non-symmetric K: relative residual of GMRES (SuperLU reaches 2-5e-12; the floor is 2e-12)
-GMRES_RESTART, GMRES_CYCLES = 60, 2
+KRYLOV_RTOL = 1e-11         # banded preconditioner: relative residual reached (SuperLU reaches 2-5e-12; the floor is 2e-12)
+KRYLOV_ITERATIONS, REFINEMENTS = 60, 4     # Krylov iterations per refinement, refinements at most
+KRYLOV_INNER_RTOL = 1e-6    # each refinement's relative residual (of its own right-hand side)
+#: the band's precisions, in the order tried: single precision halves the band's memory and its factorisation's
+#: time, for a few more Krylov iterations (16 against 12 on the 257 x 65 cantilever's default K)
+PRECONDITIONER_PRECISIONS = (np.float32, np.float64)
 PARDISO_MIN_DOFS = 4000     # auto: PARDISO (where installed) on wide-band systems from this many free dofs
-ITERATIVE_RTOL = 1e-11      # amg: relative residual of CG / GMRES, as GMRES_RTOL
+ITERATIVE_RTOL = 1e-11      # amg: relative residual of CG / GMRES, as KRYLOV_RTOL
 ITERATIVE_MAXITER = 2000    # amg: iterations before it is refused
 #: the optional solvers and the package each needs (``pip install 'ctmrpim[solvers]'``)
 OPTIONAL = {"pardiso": "pypardiso", "amg": "pyamg"}
@@ -201,52 +209,102 @@ def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray
 
 
 def _banded_cholesky(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool) -> np.ndarray | None:
-    """Solve with RCM + banded Cholesky; None when the band is too wide (auto) or A is not positive definite."""
-    factor = _band_factor(A, always, symmetric_part=False)
+    """Solve a symmetric positive definite A with RCM + banded Cholesky: conjugate gradients on the single-
+    precision factor first (:func:`_refined`), else the double-precision factor directly; None when the band is
+    too wide (auto) or A is not positive definite."""
+    order = _band_order(A, always)
+    if order is None:
+        return None
+    if not np.any(b):
+        return np.zeros_like(b)
+    if (x := _preconditioned(A, b, order, symmetric=True, precisions=PRECONDITIONER_PRECISIONS[:-1])) is not None:
+        return x
+    factor = _band_factor(A, order, symmetric_part=False, dtype=np.float64)
     return None if factor is None else _band_solve(factor, b)
 
 
 def _banded_gmres(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool) -> np.ndarray | None:
-    """Solve a non-symmetric A by GMRES preconditioned with the banded Cholesky factor of (A + A^T) / 2; None
-    when that part's band is too wide (auto), it is not positive definite, or GMRES does not reach GMRES_RTOL."""
-    factor = _band_factor(A, always, symmetric_part=True)
-    if factor is None:
+    """Solve a non-symmetric A by GMRES preconditioned with the banded Cholesky factor of (A + A^T) / 2, in
+    single precision first (PRECONDITIONER_PRECISIONS); None when that part's band is too wide (auto), it is not
+    positive definite, or GMRES does not reach KRYLOV_RTOL with either factor."""
+    order = _band_order(A, always)
+    if order is None:
         return None
     if not np.any(b):
         return np.zeros_like(b)
-    M = spla.LinearOperator(A.shape, lambda v: _band_solve(factor, np.ravel(v)), dtype=float)
+    return _preconditioned(A, b, order, symmetric=False, precisions=PRECONDITIONER_PRECISIONS)
+
+
+def _preconditioned(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, order: tuple[np.ndarray, np.ndarray, int],
+                    symmetric: bool, precisions: tuple[type, ...]) -> np.ndarray | None:
+    """x solving A x = b by :func:`_refined` on the banded Cholesky factor of A (``symmetric``) or of its
+    symmetric part, in the first of ``precisions`` whose factor exists and reaches KRYLOV_RTOL; else None."""
+    for dtype in precisions:
+        factor = _band_factor(A, order, symmetric_part=not symmetric, dtype=dtype)
+        if factor is not None:
+            M = spla.LinearOperator(A.shape, lambda v, f=factor: _band_solve(f, np.ravel(v)), dtype=float)
+            x = _refined(A, b, M, symmetric)
+            del factor, M   # the next precision's band is not allocated beside this one's
+            if x is not None:
+                return x
+    return None
+
+
+def _refined(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, M: spla.LinearOperator, symmetric: bool
+             ) -> np.ndarray | None:
+    """x with |A x - b| <= KRYLOV_RTOL |b| by iterative refinement: conjugate gradients (``symmetric``) or GMRES
+    (one cycle) of at most KRYLOV_ITERATIONS to the relative residual KRYLOV_INNER_RTOL, on the true residual,
+    at most REFINEMENTS times; None when that does not reach it. Refinement, not one Krylov solve to the final
+    tolerance: a single-precision M is not a fixed linear operator to double precision, and the solver's own
+    residual estimate then stops far from the true residual (GMRES at 2e-8 instead of 1e-11 on the 129 x 33
+    cantilever)."""
     tol = "rtol" if "rtol" in inspect.signature(spla.gmres).parameters else "tol"   # scipy < 1.12: tol
-    x, info = spla.gmres(A, b, M=M, atol=0.0, restart=GMRES_RESTART, maxiter=GMRES_CYCLES, **{tol: GMRES_RTOL})
-    if info != 0 or np.linalg.norm(A @ x - b) > 2 * GMRES_RTOL * np.linalg.norm(b):
-        return None
-    return x
+    x = np.zeros_like(b)
+    r, target = b, KRYLOV_RTOL * np.linalg.norm(b)
+    for _ in range(REFINEMENTS):
+        if symmetric:
+            dx, _info = spla.cg(A, r, M=M, atol=0.0, maxiter=KRYLOV_ITERATIONS, **{tol: KRYLOV_INNER_RTOL})
+        else:
+            dx, _info = spla.gmres(A, r, M=M, atol=0.0, restart=KRYLOV_ITERATIONS, maxiter=1,
+                                   **{tol: KRYLOV_INNER_RTOL})
+        x += dx
+        r = b - A @ x
+        if np.linalg.norm(r) <= target:
+            return x
+    return None
 
 
-def _band_factor(A: sp.csr_matrix | sp.csc_matrix, always: bool, symmetric_part: bool
-                 ) -> tuple[np.ndarray, np.ndarray] | None:
-    """(RCM permutation, lower banded Cholesky factor) of a symmetric A, or of (A + A^T) / 2 with
-    ``symmetric_part``; None when the band is too wide (auto) or not positive definite. The band of a large A
-    is filled straight from its arrays (no permuted copies of A, no A^T; chosen by size, as the symmetric
-    part's sums may differ from scipy's by round-off) and factorised in place."""
+def _band_order(A: sp.csr_matrix | sp.csc_matrix, always: bool) -> tuple[np.ndarray, np.ndarray, int] | None:
+    """(RCM permutation, its inverse: the rank of each row, lower half-bandwidth) of A's symmetrised pattern;
+    None when the band is wider than BANDED_MAX_FRACTION of the rows and not ``always``."""
     perm = reverse_cuthill_mckee(A, symmetric_mode=True)
     n = A.shape[0]
+    rank = np.empty(n, np.int64)
+    rank[perm] = np.arange(n)
     if rpim_kernels.use_compiled(A.nnz, assembly.COMPILED_MIN_ENTRIES):
-        rank = np.empty(n, np.int64)
-        rank[perm] = np.arange(n)
         bw = int(stiffness_kernels.lower_bandwidth(A.indptr, A.indices, rank))
-        if not always and bw > BANDED_MAX_FRACTION * n:
-            return None
-        ab = np.zeros((bw + 1, n), order="F")   # LAPACK's layout: factorised in place, not copied
+    else:
+        coo = A.tocoo()
+        bw = int(np.abs(rank[coo.row] - rank[coo.col]).max()) if A.nnz else 0
+    return None if not always and bw > BANDED_MAX_FRACTION * n else (perm, rank, bw)
+
+
+def _band_factor(A: sp.csr_matrix | sp.csc_matrix, order: tuple[np.ndarray, np.ndarray, int], symmetric_part: bool,
+                 dtype: type) -> tuple[np.ndarray, np.ndarray] | None:
+    """(RCM permutation, lower banded Cholesky factor in ``dtype``) of a symmetric A, or of (A + A^T) / 2 with
+    ``symmetric_part``, in the ordering ``order`` (:func:`_band_order`); None when it is not positive definite
+    (in that precision). The band of a large A is filled straight from its arrays (no permuted copies of A, no
+    A^T; chosen by size, as the symmetric part's sums may differ from scipy's by round-off) and factorised in
+    place."""
+    perm, rank, bw = order
+    n = A.shape[0]
+    ab = np.zeros((bw + 1, n), dtype=dtype, order="F")   # LAPACK's layout: factorised in place, not copied
+    if rpim_kernels.use_compiled(A.nnz, assembly.COMPILED_MIN_ENTRIES):
         stiffness_kernels.fill_lower_band(A.indptr, A.indices, A.data, rank, ab, symmetric_part)
     else:
         Ap = ((A + A.T) * 0.5 if symmetric_part else A)[perm][:, perm].tocoo()
         lower = Ap.row >= Ap.col
-        offset = Ap.row[lower] - Ap.col[lower]
-        bw = int(offset.max()) if len(offset) else 0
-        if not always and bw > BANDED_MAX_FRACTION * n:
-            return None
-        ab = np.zeros((bw + 1, n), order="F")   # LAPACK's layout: factorised in place, not copied
-        ab[offset, Ap.col[lower]] = Ap.data[lower]
+        ab[Ap.row[lower] - Ap.col[lower], Ap.col[lower]] = Ap.data[lower]
     try:
         return perm, sla.cholesky_banded(ab, lower=True, overwrite_ab=True, check_finite=False)
     except np.linalg.LinAlgError:
@@ -257,5 +315,9 @@ def _band_solve(factor: tuple[np.ndarray, np.ndarray], b: np.ndarray) -> np.ndar
     """A^-1 b from :func:`_band_factor`'s (permutation, factor)."""
     perm, cb = factor
     x = np.empty_like(b, dtype=float)
-    x[perm] = sla.cho_solve_banded((cb, True), b[perm], check_finite=False)
+    if cb.dtype == np.float32:   # cho_solve_banded would take the common type: a double copy of the band
+        y, info = lapack.spbtrs(cb, b[perm].astype(np.float32), lower=1)
+        x[perm] = y
+    else:
+        x[perm] = sla.cho_solve_banded((cb, True), b[perm], check_finite=False)
     return x
