@@ -316,8 +316,13 @@ def _band_solve(factor: tuple[np.ndarray, np.ndarray], b: np.ndarray) -> np.ndar
     perm, cb = factor
     x = np.empty_like(b, dtype=float)
     if cb.dtype == np.float32:   # cho_solve_banded would take the common type: a double copy of the band
-        y, info = lapack.spbtrs(cb, b[perm].astype(np.float32), lower=1)
-        x[perm] = y
+        # scaled to unit size: the refinements' residuals shrink by 1e-6 each and would leave single precision's
+        # range for loads in small units
+        scale = float(np.abs(b).max())
+        if scale == 0.0:
+            return np.zeros_like(b, dtype=float)
+        y, _info = lapack.spbtrs(cb, (b[perm] / scale).astype(np.float32), lower=1)
+        x[perm] = scale * y
     else:
         x[perm] = sla.cho_solve_banded((cb, True), b[perm], check_finite=False)
     return x
