@@ -322,7 +322,8 @@ def _band_solve(factor: tuple[np.ndarray, np.ndarray], b: np.ndarray) -> np.ndar
         if scale == 0.0:
             return np.zeros_like(b, dtype=float)
         y, _info = lapack.spbtrs(cb, (b[perm] / scale).astype(np.float32), lower=1)
-        x[perm] = scale * y
+        x[perm] = y
+        x *= scale      # in double precision (a Python float times a float32 array stays float32)
     else:
         x[perm] = sla.cho_solve_banded((cb, True), b[perm], check_finite=False)
     return x

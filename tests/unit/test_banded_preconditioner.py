@@ -63,3 +63,22 @@ def test_a_system_single_precision_cannot_factorise_takes_the_double_precision_f
     assert [dtype for dtype, _ in seen] == [np.float32, np.float64] and seen[-1][1]
     ref = spla.spsolve(A.tocsc(), b)
     assert np.abs(x - ref).max() <= 4e8 * np.finfo(float).eps * np.abs(ref).max()
+
+
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_the_single_precision_path_is_linear_in_the_load_over_any_units(
+        monkeypatch: pytest.MonkeyPatch, symmetric: bool) -> None:
+    """Loads of 1e-30 or 1e+30 of the unit: the substitution works on the right-hand side scaled to unit size, so
+    single precision's range is never left; the answer scales with the load to the residual tolerance."""
+    A = _plate(30)
+    if not symmetric:
+        skew = sp.triu(A, 1) * 0.03
+        A = A + skew - skew.T
+    A = A.tocsc()
+    b = np.random.default_rng(3).standard_normal(A.shape[0])
+    seen = _recording_factors(monkeypatch)
+    x = linear_solver._solve(A, b, "banded", symmetric, lambda: None)
+    for scale in (1e-30, 1e30):
+        xs = linear_solver._solve(A, scale * b, "banded", symmetric, lambda: None)
+        assert np.abs(xs / scale - x).max() <= 1e-9 * np.abs(x).max()
+    assert all(dtype == np.float32 for dtype, _ in seen)          # never the double-precision fallback
