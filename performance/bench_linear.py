@@ -6,7 +6,8 @@ Every case (grid x method) runs in its own process, as a user's ``ctmrpim run`` 
 package, solves a 9 x 3 cantilever of the same method to warm up, then solves the case ``--repeat`` times.
 Printed for each case, all measured in this one run: the first solve's total (numba's cached kernels are
 loaded there), the best total of the repeats and its phases, and the process's maximum resident memory
-(``ru_maxrss`` of the child). Methods: CTM-RPIM with the default integration (``ctm-vci``) and with the
+(``ru_maxrss`` of the child) after all the repeats and after the first solve (a process that solves once, as
+``ctmrpim run`` does; the repeats add the allocator's fragmentation). Methods: CTM-RPIM with the default integration (``ctm-vci``) and with the
 paper's ``ctm``, scikit-fem Q1 and P2. Then the CTM-RPIM / FEM time ratios at equal grid, and, with three
 grids or more, the scaling exponent of each phase (time ~ n^p) and the ratios at equal tip error. BLAS
 threads follow the environment. Timings on a shared machine are noisy: the minimum over repeats is the
@@ -58,12 +59,14 @@ def child(grid: str, label: str, repeat: int) -> None:
         t0 = time.perf_counter()
         r = solve(case)
         runs.append((time.perf_counter() - t0, r))
+        if len(runs) == 1:   # a process that solves the case once, as `ctmrpim run` does (after the warm-up)
+            rss_first = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     first = runs[0][1].timings["total"]
     wall, r = min(runs, key=lambda x: x[0])
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024   # kB on Linux
     out = {"grid": grid, "method": label, "n": r.counts["nodes"],
            "points": r.counts.get("integration_points", 0), "tip_error": r.errors["probes"]["tip"]["uy"],
-           "warmup": warm_time, "first": first, "wall": wall, "rss_MB": rss,
+           "warmup": warm_time, "first": first, "wall": wall, "rss_MB": rss, "rss_first_MB": rss_first,
            **{f"t_{k}": v for k, v in r.timings.items()}}
     print(json.dumps(out))
 
@@ -96,7 +99,7 @@ def main() -> None:
             r = rows[-1]
             phases = "  ".join(f"{k[2:]} {v:.3f}" for k, v in r.items() if k.startswith("t_") and k != "t_total")
             print(f"{r['grid']:>7} {r['method']:13s} n={r['n']:6d} total {r['t_total']:7.3f} s (first {r['first']:.3f}) "
-                  f"max RSS {r['rss_MB']:6.0f} MB  tip error {100 * r['tip_error']:.4f} %  | {phases}", flush=True)
+                  f"max RSS {r['rss_MB']:6.0f} MB (one solve {r['rss_first_MB']:4.0f})  tip error {100 * r['tip_error']:.4f} %  | {phases}", flush=True)
     df = pd.DataFrame(rows)
     if a.csv:
         df.to_csv(a.csv, index=False)
