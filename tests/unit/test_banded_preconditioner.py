@@ -19,6 +19,12 @@ def _plate(n: int) -> sp.csr_matrix:
     return (sp.kron(sp.identity(n), T) + sp.kron(T, sp.identity(n))).tocsr() * 1e9   # a stiffness's magnitude
 
 
+def _with_skew(A: sp.csr_matrix) -> sp.csr_matrix:
+    """A plus a non-symmetric part of a few per cent, as the consistent schemes' K has."""
+    skew = sp.triu(A, 1) * 0.03
+    return (A + skew - skew.T).tocsr()
+
+
 def _recording_factors(monkeypatch: pytest.MonkeyPatch) -> list:
     """The precision of every band factorised, and whether it was positive definite there."""
     seen = []
@@ -35,10 +41,7 @@ def _recording_factors(monkeypatch: pytest.MonkeyPatch) -> list:
 @pytest.mark.parametrize("symmetric", [True, False])
 def test_a_single_precision_band_preconditions_to_the_double_precision_residual(
         monkeypatch: pytest.MonkeyPatch, symmetric: bool) -> None:
-    A = _plate(40)
-    if not symmetric:   # a non-symmetric part of a few per cent, as the consistent schemes' K has
-        skew = sp.triu(A, 1) * 0.03
-        A = (A + skew - skew.T).tocsr()
+    A = _plate(40) if symmetric else _with_skew(_plate(40))
     b = np.random.default_rng(1).standard_normal(A.shape[0])
     seen = _recording_factors(monkeypatch)
     x = linear_solver._solve(A.tocsc(), b, "banded", symmetric, lambda: None)
@@ -70,11 +73,7 @@ def test_the_single_precision_path_is_linear_in_the_load_over_any_units(
         monkeypatch: pytest.MonkeyPatch, symmetric: bool) -> None:
     """Loads of 1e-30 or 1e+30 of the unit: the substitution works on the right-hand side scaled to unit size, so
     single precision's range is never left; the answer scales with the load to the residual tolerance."""
-    A = _plate(30)
-    if not symmetric:
-        skew = sp.triu(A, 1) * 0.03
-        A = A + skew - skew.T
-    A = A.tocsc()
+    A = (_plate(30) if symmetric else _with_skew(_plate(30))).tocsc()
     b = np.random.default_rng(3).standard_normal(A.shape[0])
     seen = _recording_factors(monkeypatch)
     x = linear_solver._solve(A, b, "banded", symmetric, lambda: None)
