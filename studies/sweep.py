@@ -141,10 +141,12 @@ def warm_up() -> None:
 
 
 def one_core_worker() -> None:
-    """A worker process computes on one core: one RPIM thread (BLAS is limited per case)."""
-    from ctmrpim.discretisation import rpim
+    """A worker process computes on one core: one RPIM thread, one thread for the gradient products (BLAS is
+    limited per case)."""
+    from ctmrpim.discretisation import gradient_operator, rpim
 
     rpim.THREADS = 1
+    gradient_operator.THREADS = 1
 
 
 @dataclass

@@ -1,28 +1,79 @@
 """The RPIM gradient at the integration points and its transpose, the internal force (compiled, numba).
 
-With dN/dx and dN/dy of every point in one sparse pattern (a point's support), the explicit solver
-needs two products each step:
+With dN/dx and dN/dy of every point in one sparse pattern (a point's support), the explicit solver and the
+Newton systems need two products, each step or iteration:
 
     F_p = I + sum_j (x_j - x_r,j) (dN_j/dx, dN_j/dy)(x_p)                        (the gradient)
     f_j = sum_p w_p P_p (dN_j/dx, dN_j/dy)(x_p)^T                              (the internal force)
 
 As scipy products these are four passes over the matrix (two columns each way, CSR and its
-transpose); here each is one pass over the shared pattern with both derivative values. Measured on the
-1071-node column's 9591 points (416391 entries), best of 7 in one script: gradient 0.9-1.3 ms against
-1.2-1.4 ms, force 1.0 ms against 1.7 ms for scipy's products. The force scatters into the nodes in point
-order, so the sums come out in the same order every run (a resumed run repeats the uninterrupted one
-bit for bit).
+transpose); here each is one pass over the shared pattern with both derivative values, split into
+:data:`THREADS` blocks on a thread pool (the kernels release the GIL). The gradient runs over the points
+(rows); the force over the nodes (columns), gathering from the pattern transposed once per operator, with
+its derivative values laid out in column order. Each node's force is summed over its points in increasing
+point order, the order (and the fused multiply-adds) of a serial scatter in point order: the sums do not
+depend on the number of threads or the split, so a resumed explicit run repeats the uninterrupted one bit
+for bit, and a case gives the same bits on one core and on two.
+
+Why split: on the 1071-node column's 9600 points (about 413000 entries) the two passes were 2.3 of the
+5.4 ms of a step (Python's profile of a collapse run). Measured in one script on such a pattern, best of 300
+calls, one thread -> two: gradient 1.00 -> 0.81 ms, force 0.90 -> 0.53 ms (medians vary twofold on this shared
+machine). In a run the pattern (about 8 MB) is read from memory each time, and handing both blocks to the
+pool made the Newton iterations slower than one thread (waking two idle cores), hence the first block in the
+calling thread.
 """
 from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
+from ctmrpim.discretisation.stiffness_kernels import transpose_pattern
 
-@njit(cache=True, fastmath={"reassoc", "contract"})
-def _gradient(indptr, indices, dx, dy, d, out, identity):
-    for p in range(len(indptr) - 1):
+#: blocks of rows (gradient) or columns (force) computed concurrently; 1: all in the calling thread
+THREADS = 2
+#: below this many pattern entries one block does it: a pool's hand-over (tens of microseconds) would cost
+#: more than the second core saves
+PARALLEL_MIN_ENTRIES = 40_000
+_FAST = {"reassoc", "contract"}
+
+_pool: tuple[int, ThreadPoolExecutor] | None = None
+
+
+def _executor() -> ThreadPoolExecutor:
+    """A thread pool kept for the process (the products run every step): made anew in a forked child, whose
+    copy of the parent's pool has no threads."""
+    global _pool
+    if _pool is None or _pool[0] != os.getpid():
+        _pool = (os.getpid(), ThreadPoolExecutor(max_workers=max(THREADS - 1, 1), thread_name_prefix="gradient"))
+    return _pool[1]
+
+
+def _blocks(starts: np.ndarray, parts: int) -> list[tuple[int, int]]:
+    """``parts`` consecutive ranges of the rows of a pattern with row starts ``starts`` (rows + 1), of about
+    equal numbers of entries."""
+    rows = len(starts) - 1
+    cuts = np.searchsorted(starts, np.linspace(0, starts[-1], parts + 1)[1:-1])
+    edges = [0, *(int(c) for c in np.clip(cuts, 0, rows)), rows]
+    return [(a, b) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+
+
+def _run(kernel, args: tuple, blocks: list[tuple[int, int]]) -> None:
+    """``kernel(*args, *block)`` for every block: the first in the calling thread, the others on the pool (one
+    thread woken per call, not two: waking an idle core costs tens to hundreds of microseconds here)."""
+    futures = [_executor().submit(kernel, *args, *ab) for ab in blocks[1:]]
+    if blocks:
+        kernel(*args, *blocks[0])
+    for f in futures:
+        f.result()
+
+
+@njit(cache=True, nogil=True, fastmath=_FAST)
+def _gradient(indptr, indices, dx, dy, d, out, identity, p0, p1):
+    for p in range(p0, p1):
         a = b = c = e = 0.0
         for k in range(indptr[p], indptr[p + 1]):
             j = indices[k]
@@ -33,14 +84,20 @@ def _gradient(indptr, indices, dx, dy, d, out, identity):
         out[p, 0], out[p, 1], out[p, 2], out[p, 3] = identity + a, b, c, identity + e
 
 
-@njit(cache=True, fastmath={"reassoc", "contract"})
-def _force(indptr, indices, dx, dy, wP, out):
-    for p in range(len(indptr) - 1):
-        P0, P1, P2, P3 = wP[p, 0], wP[p, 1], wP[p, 2], wP[p, 3]
-        for k in range(indptr[p], indptr[p + 1]):
-            j = indices[k]
-            out[j, 0] += P0 * dx[k] + P1 * dy[k]
-            out[j, 1] += P2 * dx[k] + P3 * dy[k]
+@njit(cache=True, nogil=True, fastmath={"contract"})
+def _force(tptr, tpoint, tdx, tdy, wP, out, j0, j1):
+    # the y term first, each added on its own: the fused multiply-adds of a scatter in point order
+    # (f_j += P0 dx + P1 dy compiled with reassociation), so the sums are the same bits
+    for j in range(j0, j1):
+        fx = fy = 0.0
+        for t in range(tptr[j], tptr[j + 1]):
+            p = tpoint[t]
+            fx += wP[p, 1] * tdy[t]
+            fx += wP[p, 0] * tdx[t]
+            fy += wP[p, 3] * tdy[t]
+            fy += wP[p, 2] * tdx[t]
+        out[j, 0] = fx
+        out[j, 1] = fy
 
 
 class GradientOperator:
@@ -52,17 +109,43 @@ class GradientOperator:
         self.shape = dNdx.shape
         self.indptr, self.indices = dNdx.indptr, dNdx.indices
         self.dx, self.dy = np.ascontiguousarray(dNdx.data, float), np.ascontiguousarray(dNdy.data, float)
+        parts = THREADS if len(self.indices) >= PARALLEL_MIN_ENTRIES else 1
+        self._row_blocks = _blocks(self.indptr, parts)
+        self._pattern: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._columns: tuple[np.ndarray, np.ndarray, list[tuple[int, int]]] | None = None
+
+    def transposed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(tptr (n + 1), point (nnz), entry (nnz)): the pattern by nodes, points ascending within a node
+        (:func:`ctmrpim.discretisation.stiffness_kernels.transpose_pattern`), built once."""
+        if self._pattern is None:
+            etype = np.int32 if len(self.indices) < 2**31 - 1 else np.int64
+            point, entry = np.empty(len(self.indices), etype), np.empty(len(self.indices), etype)
+            tptr = transpose_pattern(self.indptr, self.indices, self.shape[1], point, entry)
+            self._pattern = (tptr, point, entry)
+        return self._pattern
+
+    def share_pattern(self, other: GradientOperator) -> None:
+        """Take ``other``'s transposed pattern (the same sparsity pattern) instead of building it again."""
+        if self._pattern is None and other._pattern is not None:
+            self._pattern = other._pattern
 
     def gradient(self, d: np.ndarray, identity: float = 1.0) -> np.ndarray:
         """(m, 4) F = I + grad d (xx, xy, yx, yy) of nodal displacements d (n, 2); ``identity = 0``: grad d."""
         out = np.empty((self.shape[0], 4))
-        _gradient(self.indptr, self.indices, self.dx, self.dy, np.ascontiguousarray(d, float), out, identity)
+        _run(_gradient, (self.indptr, self.indices, self.dx, self.dy, np.ascontiguousarray(d, float), out,
+                         identity), self._row_blocks)
         return out
 
     def force(self, wP: np.ndarray) -> np.ndarray:
         """(n, 2) sum_p wP_p grad N of weighted first Piola stresses wP (m, 4: xX, xY, yX, yY)."""
-        out = np.zeros((self.shape[1], 2))
-        _force(self.indptr, self.indices, self.dx, self.dy, np.ascontiguousarray(wP, float), out)
+        if self._columns is None:
+            tptr, point, entry = self.transposed()
+            parts = THREADS if len(self.indices) >= PARALLEL_MIN_ENTRIES else 1
+            self._columns = (self.dx[entry], self.dy[entry], _blocks(tptr, parts))
+        tptr, point, _ = self.transposed()
+        tdx, tdy, blocks = self._columns
+        out = np.empty((self.shape[1], 2))
+        _run(_force, (tptr, point, tdx, tdy, np.ascontiguousarray(wP, float), out), blocks)
         return out
 
 

@@ -61,6 +61,7 @@ class PointProducts:
 
     def force(self, P: np.ndarray) -> np.ndarray:
         """(2n,) sum_p w_p P_p grad~N of the first Piola stresses P (m, 4: xX, xY, yX, yY), interleaved."""
+        self._transpose()       # built once, shared by the test operator
         return self.tested.force(P * self.w[:, None]).ravel()
 
     def corrected(self, K0: sp.csr_matrix, points: np.ndarray, D: np.ndarray) -> sp.csr_matrix | None:
@@ -119,13 +120,10 @@ class PointProducts:
         return K
 
     def _transpose(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """node -> (point, entry) lists of the points' pattern (:func:`kernels.transpose_pattern`), built once."""
+        """node -> (point, entry) lists of the points' pattern (:meth:`GradientOperator.transposed`), built once."""
         if self._transposed is None:
-            tr = self.trial
-            etype = np.int32 if len(tr.indices) < 2**31 - 1 else np.int64
-            trow, tent = np.empty(len(tr.indices), etype), np.empty(len(tr.indices), etype)
-            tptr = kernels.transpose_pattern(tr.indptr, tr.indices, self.n, trow, tent)
-            self._transposed = (tptr, trow, tent)
+            self._transposed = self.trial.transposed()
+            self.tested.share_pattern(self.trial)     # the force gathers by it too
         return self._transposed
 
 

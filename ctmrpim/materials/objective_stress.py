@@ -34,6 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from ctmrpim.errors import ProblemError
+from ctmrpim.materials import objective_stress_kernels as kernels
 from ctmrpim.materials.neo_hookean import NeoHookean
 
 #: Complex-step size: the derivative is exact to round-off for any h this small (no subtraction).
@@ -212,27 +213,33 @@ def complex_step_tangent(update: HypoelasticUpdate | LeftCauchyGreenUpdate, f: n
 # The explicit solver updates tens of thousands of points every step; numpy's batched 2 x 2 matmul is
 # slow for such small matrices, so its step writes the same algebra out in components. A gradient is
 # stored (m, 4) as xx, xy, yx, yy (F[:, 1] = dx/dY); a stress or strain tensor (m, 4) as xx, yy, xy, zz.
+# The loops of det_c, relative_c, first_piola_c and largest_strain_c are compiled
+# (:mod:`ctmrpim.materials.objective_stress_kernels`).
 # tests/test_explicit_dynamics.py checks each against the matrix forms above.
+
+def _f(a: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=float)
+
 
 def det_c(F: np.ndarray) -> np.ndarray:
     """(m,) det F of gradients F (m, 4: xx, xy, yx, yy)."""
-    return F[:, 0] * F[:, 3] - F[:, 1] * F[:, 2]
+    out = np.empty(len(F))
+    kernels.det(_f(F), out)
+    return out
 
 
 def first_piola_c(stress: np.ndarray, F: np.ndarray) -> np.ndarray:
     """(m, 4) P = det F sigma F^-T (xX, xY, yX, yY) of Cauchy stresses (m, 4) at gradients F (m, 4)."""
-    sxx, syy, sxy = stress[:, 0], stress[:, 1], stress[:, 2]
-    F00, F01, F10, F11 = F.T
-    return np.stack([sxx * F11 - sxy * F01, sxy * F00 - sxx * F10,
-                     sxy * F11 - syy * F01, syy * F00 - sxy * F10], axis=1)
+    out = np.empty((len(F), 4))
+    kernels.first_piola(_f(stress), _f(F), out)
+    return out
 
 
 def relative_c(F_new: np.ndarray, F: np.ndarray) -> np.ndarray:
     """(m, 4) f = F_new F^-1."""
-    J = det_c(F)
-    a00, a01, a10, a11 = F_new.T
-    i00, i01, i10, i11 = F[:, 3] / J, -F[:, 1] / J, -F[:, 2] / J, F[:, 0] / J
-    return np.stack([a00 * i00 + a01 * i10, a00 * i01 + a01 * i11, a10 * i00 + a11 * i10, a10 * i01 + a11 * i11], axis=1)
+    out = np.empty((len(F), 4))
+    kernels.relative(_f(F_new), _f(F), out)
+    return out
 
 
 def hughes_winget_components(f00: np.ndarray | float, f01: np.ndarray | float, f10: np.ndarray | float,
@@ -273,9 +280,5 @@ def rotate_c(state: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 
 def largest_strain_c(F: np.ndarray) -> float:
-    """Largest |principal stretch - 1| over gradients (m, 4), from C = F^T F."""
-    C00, C11 = F[:, 0] ** 2 + F[:, 2] ** 2, F[:, 1] ** 2 + F[:, 3] ** 2
-    C01 = F[:, 0] * F[:, 1] + F[:, 2] * F[:, 3]
-    mean, half = 0.5 * (C00 + C11), np.hypot(0.5 * (C00 - C11), C01)
-    big, small = np.sqrt(mean + half), np.sqrt(np.maximum(mean - half, 0.0))
-    return float(max(np.abs(big - 1.0).max(), np.abs(small - 1.0).max())) if len(F) else 0.0
+    """Largest |principal stretch - 1| over gradients (m, 4), from C = F^T F (NaN where one is not finite)."""
+    return float(kernels.largest_strain(_f(F)))

@@ -122,8 +122,7 @@ def _solve(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, solver: str, sym
     if solver == "amg":
         return _amg(Kff, rhs, symmetric, modes())
     if solver in ("auto", "banded"):
-        banded = _banded_cholesky if symmetric else _banded_gmres
-        if (x := banded(Kff, rhs, solver == "banded")) is not None:
+        if (x := _banded(Kff, rhs, solver == "banded", symmetric)) is not None:
             return x
     if solver == "pardiso" or (solver == "auto" and len(rhs) >= PARDISO_MIN_DOFS and available("pardiso")):
         return _pardiso(Kff, rhs, symmetric)
@@ -208,31 +207,23 @@ def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray
     return A, rhs
 
 
-def _banded_cholesky(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool) -> np.ndarray | None:
-    """Solve a symmetric positive definite A with RCM + banded Cholesky: conjugate gradients on the single-
-    precision factor first (:func:`_refined`), else the double-precision factor directly; None when the band is
-    too wide (auto) or A is not positive definite."""
-    order = _band_order(A, always)
-    if order is None:
-        return None
-    if not np.any(b):
-        return np.zeros_like(b)
-    if (x := _preconditioned(A, b, order, symmetric=True, precisions=PRECONDITIONER_PRECISIONS[:-1])) is not None:
-        return x
-    factor = _band_factor(A, order, symmetric_part=False, dtype=np.float64)
-    return None if factor is None else _band_solve(factor, b)
-
-
-def _banded_gmres(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool) -> np.ndarray | None:
-    """Solve a non-symmetric A by GMRES preconditioned with the banded Cholesky factor of (A + A^T) / 2, in
-    single precision first (PRECONDITIONER_PRECISIONS); None when that part's band is too wide (auto), it is not
+def _banded(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool, symmetric: bool) -> np.ndarray | None:
+    """Solve A x = b on A's RCM band: a ``symmetric`` positive definite A by conjugate gradients on the single-
+    precision banded Cholesky factor (:func:`_refined`), else by the double-precision factor directly; a
+    non-symmetric A by GMRES preconditioned with the factor of (A + A^T) / 2, single precision first
+    (PRECONDITIONER_PRECISIONS). None when the band is too wide (auto, not ``always``), the factor's matrix is not
     positive definite, or GMRES does not reach KRYLOV_RTOL with either factor."""
     order = _band_order(A, always)
     if order is None:
         return None
     if not np.any(b):
         return np.zeros_like(b)
-    return _preconditioned(A, b, order, symmetric=False, precisions=PRECONDITIONER_PRECISIONS)
+    if not symmetric:
+        return _preconditioned(A, b, order, symmetric=False, precisions=PRECONDITIONER_PRECISIONS)
+    if (x := _preconditioned(A, b, order, symmetric=True, precisions=PRECONDITIONER_PRECISIONS[:-1])) is not None:
+        return x
+    factor = _band_factor(A, order, symmetric_part=False, dtype=np.float64)
+    return None if factor is None else _band_solve(factor, b)
 
 
 def _preconditioned(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, order: tuple[np.ndarray, np.ndarray, int],

@@ -18,6 +18,7 @@ from ctmrpim.discretisation.rpim import ShapeFunctions
 from ctmrpim.discretisation.stress_recovery import recovered_stress
 from ctmrpim.errors import ProblemError
 from ctmrpim.problem.case import Case
+from ctmrpim.problem.model import Problem
 from ctmrpim.reference.error_norms import relative_errors
 from ctmrpim.result import Result, out_of_plane_stress, probe_errors, probe_record
 from ctmrpim.solvers.linear_solver import constrained_system, solve_free
@@ -29,22 +30,6 @@ from ctmrpim.timing import Timer
 ERROR_CELL = 2.0
 ERROR_GAUSS = 3
 ERROR_MIN_BAND = 0.25   # merge vertex ordinates closer than this (x d_c): circles have hundreds of vertices
-
-
-def consistent_stiffness(case: Case, conf: Configuration, tags: BoundaryTags, D: np.ndarray,
-                         release_values: bool = False) -> sp.csr_matrix:
-    """K (2n x 2n) of ``method.integration = "ctm-vci"``: Petrov-Galerkin with the corrected test gradients,
-    minus the Dirichlet consistency term (:mod:`ctmrpim.discretisation.consistent_integration`). With
-    ``release_values``, the shape-function values at the points (``conf.sf.N``), which the correction is the
-    last to need, are dropped before K is assembled (the load vector must have been built)."""
-    thickness = case.problem.thickness
-    boundary, sf_b, test_dx, test_dy = consistent_integration.corrected_test_gradients(conf, case.method, thickness)
-    if release_values:
-        conf.sf.N = None
-    K = assembly.stiffness(conf.sf.dNdx, conf.sf.dNdy, conf.w, D, test=(test_dx, test_dy))
-    del test_dx, test_dy
-    return assembly.subtract(K, consistent_integration.dirichlet_consistency(len(conf.x), tags.fixed, boundary, sf_b, D,
-                                                                             thickness))
 
 
 def nodal_stiffness_and_load(case: Case, conf: Configuration, tags: BoundaryTags, D: np.ndarray
@@ -66,7 +51,7 @@ def nodal_stiffness_and_load(case: Case, conf: Configuration, tags: BoundaryTags
     return K, assembly.load_vector(nodal.N_boundary, q.weights * thickness, tx, ty)
 
 
-def _point_loads(conf: Configuration, problem) -> np.ndarray:
+def _point_loads(conf: Configuration, problem: Problem) -> np.ndarray:
     """The load vector (2n,) of the point forces, the body force and the body load at the integration points."""
     F = problem.thickness * conf.point_forces(problem)
     F += assembly.body_force_vector(conf.sf.N, conf.w, problem)
@@ -94,12 +79,17 @@ def solve_ctmrpim(case: Case) -> Result:
     else:
         F = assembly.load_vector(N_traction, traction_q.weights * problem.thickness, tags.tx, tags.ty)
         F += _point_loads(conf, problem)
-        # the values at the points have served the loads (and serve the correction): they leave before the
-        # stiffness is assembled, so that they are not held beside it through the solve (58 MB at 257 x 65)
-        if scheme == "ctm-vci":
-            K = consistent_stiffness(case, conf, tags, D, release_values=True)
+        if scheme == "ctm-vci":   # Petrov-Galerkin with the corrected test gradients
+            q, sf_q, test_dx, test_dy = consistent_integration.corrected_test_gradients(conf, method, problem.thickness)
+        # the values at the points have served the loads and the correction: they leave before the stiffness is
+        # assembled, so that they are not held beside it through the solve (58 MB at 257 x 65)
+        conf.sf.N = None
+        if scheme == "ctm-vci":   # ... minus the Dirichlet consistency term
+            K = assembly.stiffness(sf.dNdx, sf.dNdy, conf.w, D, test=(test_dx, test_dy))
+            del test_dx, test_dy
+            K = assembly.subtract(K, consistent_integration.dirichlet_consistency(len(nodes), fixed, q, sf_q, D,
+                                                                                  problem.thickness))
         else:
-            conf.sf.N = None
             K = assembly.stiffness(sf.dNdx, sf.dNdy, conf.w, D)
     # the counts that set the work of the solve, shown while it runs (the progress reporter)
     timer.lap("assembly", integration_points=len(conf.w), dofs=K.shape[0], nonzeros=int(K.nnz))

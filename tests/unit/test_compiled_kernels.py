@@ -231,8 +231,8 @@ def test_non_symmetric_solve_by_gmres_on_the_symmetric_part_matches_superlu(monk
     A.sort_indices()
     F, fixed, values = rng.random(n), np.array([1, 9, 50]), rng.random(3)
     calls = []
-    original = linear_solver._banded_gmres
-    monkeypatch.setattr(linear_solver, "_banded_gmres", lambda *a: calls.append(x := original(*a)) or x)
+    original = linear_solver._banded
+    monkeypatch.setattr(linear_solver, "_banded", lambda *a: calls.append(x := original(*a)) or x)
     ref = linear_solver.solve_constrained(A, F, fixed, values, "superlu", symmetric=False)
     for numpy_path in (False, True):
         if numpy_path:

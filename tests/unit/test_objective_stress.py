@@ -107,3 +107,33 @@ def test_neo_hookean_closed_form_tangent_is_the_complex_step_one() -> None:
     state = np.c_[b[:, 0, 0], b[:, 1, 1], b[:, 0, 1]]
     A, reference = update.tangent(f, state), complex_step_tangent(update, f, state)
     assert np.abs(A - reference).max() <= 1e-12 * np.abs(reference).max()
+
+
+def test_compiled_component_loops_are_the_numpy_expressions_bit_for_bit(gradients):
+    """The compiled loops (objective_stress_kernels) do the numpy forms' arithmetic operation for operation: an
+    explicit run gives the same bits as before they were compiled; a gradient that is not finite is no small
+    strain (NaN, as numpy's max gives)."""
+    F = gradients
+    G = gradients[::-1].copy()
+    stress = np.random.default_rng(5).standard_normal((50, 4))
+    F00, F01, F10, F11 = F.T
+    J = F00 * F11 - F01 * F10
+    assert np.array_equal(det_c(F), J)
+    sxx, syy, sxy = stress[:, 0], stress[:, 1], stress[:, 2]
+    assert np.array_equal(first_piola_c(stress, F), np.stack(
+        [sxx * F11 - sxy * F01, sxy * F00 - sxx * F10, sxy * F11 - syy * F01, syy * F00 - sxy * F10], axis=1))
+    i00, i01, i10, i11 = F11 / J, -F01 / J, -F10 / J, F00 / J
+    a00, a01, a10, a11 = G.T
+    assert np.array_equal(relative_c(G, F), np.stack(
+        [a00 * i00 + a01 * i10, a00 * i01 + a01 * i11, a10 * i00 + a11 * i10, a10 * i01 + a11 * i11], axis=1))
+    C00, C11, C01 = F00 ** 2 + F10 ** 2, F01 ** 2 + F11 ** 2, F00 * F01 + F10 * F11
+    mean, half = 0.5 * (C00 + C11), np.hypot(0.5 * (C00 - C11), C01)
+    big, small = np.sqrt(mean + half), np.sqrt(np.maximum(mean - half, 0.0))
+    assert largest_strain_c(F) == max(np.abs(big - 1.0).max(), np.abs(small - 1.0).max())
+    assert largest_strain_c(F[:, ::-1][:, ::-1]) == largest_strain_c(F)      # a strided view
+    assert largest_strain_c(np.zeros((0, 4))) == 0.0
+    bad = F.copy()
+    bad[7, 2] = np.nan
+    assert np.isnan(largest_strain_c(bad))
+    bad[7, 2] = np.inf
+    assert np.isnan(largest_strain_c(bad))
