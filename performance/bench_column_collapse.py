@@ -22,8 +22,14 @@ import pandas as pd
 from ctmrpim import benchmarks
 from ctmrpim.solvers.explicit.run import solve_explicit
 
-TARGET_S = 60.0
 PHASES = ("forces", "material", "rebuild", "transfer", "time_step", "output", "checkpoint")
+#: (largest node count, wall-time target in s): the paper's 1071-node cloud, the 2016-node one
+TARGETS = ((1100, 60.0), (2100, 240.0))
+
+
+def target(nodes: int) -> float | None:
+    """The wall-time target of a cloud of ``nodes`` (None beyond the targets' clouds)."""
+    return next((t for most, t in TARGETS if nodes <= most), None)
 
 
 def main() -> None:
@@ -38,14 +44,16 @@ def main() -> None:
         wall = time.perf_counter() - t0
     d, t = r.outcome["dynamics"], r.timings
     row = {"nodes": r.counts["nodes"], "points": r.counts["integration_points"], "wall_s": round(wall, 1),
-           "target_s": TARGET_S, "simulated_s": round(d["end_time"], 4), "at_rest": d["at_rest"],
+           "target_s": target(r.counts["nodes"]), "simulated_s": round(d["end_time"], 4), "at_rest": d["at_rest"],
            "steps": d["steps"] + d["stage_steps"], "dt_min_s": f"{d['dt']['min']:.3g}",
            "dt_max_s": f"{d['dt']['max']:.3g}", "rebuilds": d["rebuilds"], "re-layings": d["state_transfers"],
            "ms_per_step": round(1e3 * wall / (d["steps"] + d["stage_steps"]), 2)}
     row.update({f"{k} %": round(100 * t.get(k, 0.0) / wall, 1) for k in PHASES})
     pd.set_option("display.width", 250)
     print(pd.DataFrame([row]).to_string(index=False))
-    print(f"\n{'met' if wall <= TARGET_S else 'NOT met'}: {wall:.0f} s against {TARGET_S:.0f} s")
+    goal = target(r.counts["nodes"])
+    if goal is not None:
+        print(f"\n{'met' if wall <= goal else 'NOT met'}: {wall:.0f} s against {goal:.0f} s")
 
 
 if __name__ == "__main__":
