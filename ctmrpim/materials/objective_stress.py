@@ -215,7 +215,8 @@ def complex_step_tangent(update: HypoelasticUpdate | LeftCauchyGreenUpdate, f: n
 # stored (m, 4) as xx, xy, yx, yy (F[:, 1] = dx/dY); a stress or strain tensor (m, 4) as xx, yy, xy, zz.
 # The loops of det_c, relative_c, first_piola_c and largest_strain_c are compiled
 # (:mod:`ctmrpim.materials.objective_stress_kernels`).
-# tests/test_explicit_dynamics.py checks each against the matrix forms above.
+# tests/unit/test_objective_stress.py checks each against the matrix forms above, and the compiled loops
+# against the numpy expressions bit for bit.
 
 def _f(a: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=float)
