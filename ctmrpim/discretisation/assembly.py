@@ -53,28 +53,52 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     trow, tent = np.empty(dNdx.nnz, etype), np.empty(dNdx.nnz, etype)
     tptr = kernels.transpose_pattern(indptr, indices, n, trow, tent)
     blocks = [(a, min(a + ROW_BLOCK, n)) for a in range(0, n, ROW_BLOCK)]
-    counts = np.zeros(n, np.int64)
-    run_blocks(lambda ab: kernels.row_counts(indptr, indices, tptr, trow, n, *ab, counts), blocks)
-    node_start = np.zeros(n + 1, np.int64)
-    np.cumsum(counts, out=node_start[1:])
-    nnz = 4 * int(node_start[-1])
-    itype = np.int32 if max(nnz, 2 * n) < 2**31 - 1 else np.int64
-    k_indices = np.empty(nnz, itype)
-    k_data = np.empty(nnz)
-    k_indptr = np.empty(2 * n + 1, itype)
-    k_indptr[0:-1:2] = 4 * node_start[:-1]
-    k_indptr[1::2] = 4 * node_start[:-1] + 2 * counts
-    k_indptr[-1] = nnz
+    node_start, neighbours = node_pattern(indptr, indices, tptr, trow, n, blocks)
+    k_indices, k_data, k_indptr = interleaved_arrays(node_start)
     # symmetric K (Galerkin, symmetric D) on sorted rows: the upper blocks summed, the lower ones copied
     upper = test is None and np.array_equal(D, D.T) and dNdx.has_canonical_format
     run_blocks(lambda ab: kernels.stiffness_rows(indptr, indices, *data, w, Dc, tptr, trow, tent, n, node_start,
-                                                 *ab, k_indices, k_data, upper), blocks)
+                                                 neighbours, *ab, k_indices, k_data, upper), blocks)
     if upper:
         run_blocks(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks)
     K = sp.csr_matrix((k_data, k_indices, k_indptr), shape=(2 * n, 2 * n), copy=False)
     K.has_sorted_indices = True
     K.has_canonical_format = True
     return K
+
+
+def node_pattern(indptr: np.ndarray, indices: np.ndarray, tptr: np.ndarray, trow: np.ndarray, n: int,
+                 blocks: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
+    """K's node pattern from the points' pattern (indptr, indices) over ``n`` nodes and its transpose (tptr,
+    trow): (node_start (n + 1), the sorted neighbours of every node row, row after row), node J a neighbour of
+    I where they share an integration point; the rows in ``blocks`` on the thread pool."""
+    parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+
+    def rows(ab: tuple[int, int]) -> None:
+        parts[ab] = kernels.node_pattern_rows(indptr, indices, tptr, trow, n, *ab)
+
+    run_blocks(rows, blocks)
+    node_start = np.zeros(n + 1, np.int64)
+    if blocks:
+        np.cumsum(np.concatenate([parts[ab][0] for ab in blocks]), out=node_start[1:])
+        neighbours = np.concatenate([parts[ab][1] for ab in blocks])
+    else:
+        neighbours = np.zeros(0, indices.dtype)
+    return node_start, neighbours
+
+
+def interleaved_arrays(node_start: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """K's CSR arrays (indices, data: empty; indptr: filled) for the interleaved dofs of a node pattern with
+    ``node_start`` (n + 1): node row I owns entries 4 node_start[I] .. 4 node_start[I + 1], row 2I's first."""
+    n = len(node_start) - 1
+    counts = np.diff(node_start)
+    nnz = 4 * int(node_start[-1])
+    itype = np.int32 if max(nnz, 2 * n) < 2**31 - 1 else np.int64
+    k_indptr = np.empty(2 * n + 1, itype)
+    k_indptr[0:-1:2] = 4 * node_start[:-1]
+    k_indptr[1::2] = 4 * node_start[:-1] + 2 * counts
+    k_indptr[-1] = nnz
+    return np.empty(nnz, itype), np.empty(nnz), k_indptr
 
 
 def subtract(K: sp.csr_matrix, C: sp.csr_matrix) -> sp.csr_matrix:

@@ -37,7 +37,7 @@ class PointProducts:
         self.w = np.ascontiguousarray(w, dtype=float)
         self.n = trial.shape[1]
         self._transposed: tuple[np.ndarray, ...] | None = None
-        self._node_start: np.ndarray | None = None
+        self._pattern: tuple[np.ndarray, np.ndarray] | None = None
         self.blocks = [(a, min(a + assembly.ROW_BLOCK, self.n)) for a in range(0, self.n, assembly.ROW_BLOCK)]
         # the tangent is rebuilt every Newton iteration, also on small clouds: its rows in one block per thread there
         size = min(assembly.ROW_BLOCK, max(1, -(-self.n // assembly.THREADS)))
@@ -90,28 +90,18 @@ class PointProducts:
         half-empty 4 x 2 blocks. Its pattern is every pair of nodes that share a point, column indices sorted."""
         tr, te = self.trial, self.tested
         tptr, trow, tent = self._transpose()
-        if self._node_start is None:     # K's pattern sizes, once: the points and their supports do not change
-            counts = np.zeros(self.n, np.int64)
-            assembly.run_blocks(lambda ab: kernels.row_counts(tr.indptr, tr.indices, tptr, trow, self.n, *ab, counts),
-                                self.blocks)
-            self._node_start = np.zeros(self.n + 1, np.int64)
-            np.cumsum(counts, out=self._node_start[1:])
-        node_start = self._node_start
-        counts = np.diff(node_start)
-        nnz = 4 * int(node_start[-1])
-        itype = np.int32 if max(nnz, 2 * self.n) < 2**31 - 1 else np.int64
-        k_indices, k_data, k_indptr = np.empty(nnz, itype), np.empty(nnz), np.empty(2 * self.n + 1, itype)
-        k_indptr[0:-1:2] = 4 * node_start[:-1]
-        k_indptr[1::2] = 4 * node_start[:-1] + 2 * counts
-        k_indptr[-1] = nnz
+        if self._pattern is None:     # K's node pattern, once: the points and their supports do not change
+            self._pattern = assembly.node_pattern(tr.indptr, tr.indices, tptr, trow, self.n, self.blocks)
+        node_start, neighbours = self._pattern
+        k_indices, k_data, k_indptr = assembly.interleaved_arrays(node_start)
         Ac = np.ascontiguousarray(np.reshape(A, (len(self.w), 16)), dtype=float)
         # symmetric K (Galerkin, every A_p symmetric: a hyperelastic dP/dF) on sorted rows: half the work
         square = Ac.reshape(-1, 4, 4)
         upper = te is tr and self.sorted and bool(np.array_equal(square, square.transpose(0, 2, 1)))
         blocks = self.tangent_blocks
         assembly.run_blocks(lambda ab: kernels.tangent_rows(tr.indptr, tr.indices, tr.dx, tr.dy, te.dx, te.dy, self.w,
-                                                            Ac, tptr, trow, tent, self.n, node_start, *ab, k_indices,
-                                                            k_data, upper), blocks)
+                                                            Ac, tptr, trow, tent, self.n, node_start, neighbours, *ab,
+                                                            k_indices, k_data, upper), blocks)
         if upper:
             assembly.run_blocks(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks)
         K = sp.csr_matrix((k_data, k_indices, k_indptr), shape=(2 * self.n, 2 * self.n), copy=False)

@@ -96,7 +96,7 @@ def test_warm_up_compiles_the_kernels_that_large_cases_take() -> None:
 
     sweep._warm = False
     sweep._warm_up()
-    kernels = (rpim_kernels.support_counts, rpim_kernels.rpim_rows, stiffness_kernels.row_counts,
+    kernels = (rpim_kernels.support_counts, rpim_kernels.rpim_rows, stiffness_kernels.node_pattern_rows,
                stiffness_kernels.stiffness_rows, stiffness_kernels.mirror_lower, stiffness_kernels.constrained_csc,
                stiffness_kernels.lower_bandwidth, stiffness_kernels.fill_lower_band, vci_kernels.moments,
                vci_kernels.corrected)
