@@ -183,8 +183,9 @@ def _inside(q: np.ndarray, poly: np.ndarray) -> np.ndarray:
 def _loops(points: np.ndarray, tri: np.ndarray) -> list[np.ndarray]:
     """Chain the boundary edges of counter-clockwise triangles into loops, body on the left."""
     directed = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
-    key = np.sort(directed, axis=1)
-    _, inv, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    # an edge's key as one integer (a row-wise np.unique sorts rows as records: ten times slower)
+    key = np.minimum(directed[:, 0], directed[:, 1]).astype(np.int64) * len(points) + directed.max(axis=1)
+    _, inv, counts = np.unique(key, return_inverse=True, return_counts=True)
     edges = directed[counts[inv.ravel()] == 1]
     if len(edges) == 0:
         return []

@@ -21,10 +21,15 @@ a linear fit over 1.5 d_c 3091 at 0.125, over 2.5 d_c 2869 at 0.25).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 from scipy.spatial import cKDTree
 
+from ctmrpim.discretisation import rpim_kernels
+from ctmrpim.discretisation.rpim import COMPILED_MIN_POINTS
 from ctmrpim.errors import ProblemError
 
 #: fitting radius rho / d_c and polynomial order of the recovery (measured above)
@@ -64,6 +69,8 @@ def recovery_operator(at: np.ndarray, points: np.ndarray, weights: np.ndarray, d
     point_tree = cKDTree(points)
     kth = point_tree.query(at, k=need)[0][:, -1]
     rho_i = np.maximum(radius * d_c, 1.5 * kth)
+    if rpim_kernels.use_compiled(len(points), COMPILED_MIN_POINTS):
+        return _compiled_operator(at, points, weights, d_c, rho_i, t)
     # every pair, those at distance 0 too (an evaluation point on an integration point), as plain arrays
     pairs = cKDTree(at).sparse_distance_matrix(point_tree, rho_i.max(), output_type="ndarray")
     pairs = pairs[pairs["v"] <= rho_i[pairs["i"]]]
@@ -80,3 +87,75 @@ def recovery_operator(at: np.ndarray, points: np.ndarray, weights: np.ndarray, d
     # sum_p kernel P(x_p) sigma_p, so each pair's weight is kernel (M^-1)[0] . P(x_p)
     first = np.linalg.solve(M, np.broadcast_to(np.eye(t)[0], (k, t))[..., None])[..., 0]   # M symmetric
     return sp.csr_matrix((kernel * np.einsum("ea,ea->e", first[i], P), (i, p)), shape=(k, len(points)))
+
+
+def _compiled_operator(at: np.ndarray, points: np.ndarray, weights: np.ndarray, d_c: float, rho: np.ndarray,
+                       terms: int) -> sp.csr_matrix:
+    """:func:`recovery_operator` by the compiled kernels, for many integration points: the pairs found on a cell
+    grid of the points (as the RPIM supports are), each row's fit solved in place (0.09 -> 0.01 s on the 129 x 33
+    cantilever's 38318 points and 4259 nodes)."""
+    at = np.ascontiguousarray(at, dtype=float)
+    points = np.ascontiguousarray(points, dtype=float)
+    grid = rpim_kernels.cell_grid(points, float(rho.max()))
+    none = np.zeros((1, 2))
+    raw, kept = np.zeros(len(at), np.int64), np.zeros(len(at), np.int64)
+    rpim_kernels.support_counts(points, *grid, at, rho, none, none, 0.0, False, raw, kept)
+    indptr = np.zeros(len(at) + 1, np.int64)
+    np.cumsum(raw, out=indptr[1:])
+    indices, data = np.empty(indptr[-1], np.int64), np.empty(indptr[-1])
+    bad = _recovery_rows(points, *grid, np.ascontiguousarray(weights, dtype=float), at, rho, float(d_c), terms,
+                         indptr, indices, data)
+    if bad >= 0:
+        raise ProblemError(f"stress recovery: the fit at ({at[bad, 0]:.6g}, {at[bad, 1]:.6g}) is singular "
+                           "(its integration points are collinear)")
+    R = sp.csr_matrix((data, indices, indptr), shape=(len(at), len(points)), copy=False)
+    R.has_sorted_indices = True
+    return R
+
+
+@njit(cache=True, nogil=True, fastmath={"contract"})
+def _recovery_rows(points, order, start, origin, h, ncx, ncy, weights, at, rho, d_c, terms, indptr, indices, data):
+    """The rows of R (:func:`recovery_operator`) into CSR arrays sized by the pair counts: for each evaluation
+    point the integration points within its radius (increasing index), the moment matrix M of the weighted fit,
+    M^-1 e_0 by :func:`ctmrpim.discretisation.rpim_kernels.lu_solve` (M symmetric), and each pair's weight
+    kernel (M^-1 e_0) . P(x_p). Returns the first evaluation point whose M is singular, else -1."""
+    kmax = 1
+    for i in range(len(at)):
+        kmax = max(kmax, indptr[i + 1] - indptr[i])
+    sup = np.empty(kmax, np.int64)
+    P = np.empty((kmax, terms))
+    kern = np.empty(kmax)
+    M = np.empty((terms, terms))
+    e = np.empty((1, terms))
+    none = np.zeros((1, 2))
+    for i in range(len(at)):
+        xi, yi, r = at[i, 0], at[i, 1], rho[i]
+        s = rpim_kernels._support(points, order, start, origin, h, ncx, ncy, i, xi, yi, r, none, none, 0.0, False,
+                                  sup)
+        for a in range(terms):
+            e[0, a] = 0.0
+            for b in range(terms):
+                M[a, b] = 0.0
+        e[0, 0] = 1.0
+        for q in range(s):
+            p = sup[q]
+            dx, dy = points[p, 0] - xi, points[p, 1] - yi
+            u = math.sqrt(dx * dx + dy * dy) / r
+            kern[q] = weights[p] * (1.0 - 6.0 * u ** 2 + 8.0 * u ** 3 - 3.0 * u ** 4)
+            bx, by = dx / d_c, dy / d_c
+            P[q, 0], P[q, 1], P[q, 2] = 1.0, bx, by
+            if terms == 6:
+                P[q, 3], P[q, 4], P[q, 5] = bx * bx, bx * by, by * by
+            for a in range(terms):
+                for b in range(terms):
+                    M[a, b] += kern[q] * P[q, a] * P[q, b]
+        if not rpim_kernels.lu_solve(M, e, terms, 1):
+            return i
+        o = indptr[i]
+        for q in range(s):
+            v = 0.0
+            for a in range(terms):
+                v += e[0, a] * P[q, a]
+            indices[o + q] = sup[q]
+            data[o + q] = kern[q] * v
+    return -1

@@ -5,12 +5,16 @@ Why compiled: the correction sums, per node, moments over every (point, node) en
 and then adds a per-node polynomial to every entry. As numpy expressions these are a dozen weighted
 ``bincount`` passes and an array of size entries x 3 for q, gathered node data of the same size, and the
 corrected arrays; here each is one loop over the entries with q computed on the fly, so the working memory
-is the per-node moments (n x 3 x 3) besides the two corrected gradient arrays.
+is the per-node moments (n x 3 x 3) besides the two corrected gradient arrays. Indices are unsigned (numba wraps
+a signed index on every load: measured on the 129 x 33 cantilever's 1.77 million entries, the correction's two
+passes 24 + 57 ms -> 24 + 11 ms).
 """
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, uint64
+
+_1 = uint64(1)
 
 
 @njit(cache=True, nogil=True)
@@ -21,10 +25,10 @@ def moments(indptr, indices, dx, dy, N, w, points, nodes, d_c, quadratic, b_indp
     q = [1, (x - x_I) / d_c, (y - y_I) / d_c] (quadratic), or q = [1] (linear: only M[:, 0, 0], R[:, 0, :])."""
     nq = 3 if quadratic else 1
     q = np.empty(3)
-    for p in range(len(indptr) - 1):
+    for p in range(uint64(len(indptr) - 1)):
         wp = w[p]
-        for e in range(indptr[p], indptr[p + 1]):
-            i = indices[e]
+        for e in range(uint64(indptr[p]), uint64(indptr[p + _1])):
+            i = uint64(indices[e])
             q[0] = 1.0
             if quadratic:
                 q[1] = (points[p, 0] - nodes[i, 0]) / d_c
@@ -38,9 +42,9 @@ def moments(indptr, indices, dx, dy, N, w, points, nodes, d_c, quadratic, b_indp
                 # d_k q_a is 1/d_c for (k, a) = (x, 1) and (y, 2), else 0
                 R[i, 1, 0] -= wp * N[e] / d_c
                 R[i, 2, 1] -= wp * N[e] / d_c
-    for b in range(len(b_indptr) - 1):
-        for e in range(b_indptr[b], b_indptr[b + 1]):
-            i = b_indices[e]
+    for b in range(uint64(len(b_indptr) - 1)):
+        for e in range(uint64(b_indptr[b]), uint64(b_indptr[b + _1])):
+            i = uint64(b_indices[e])
             bw = b_w[b] * b_N[e]
             q[0] = 1.0
             if quadratic:
@@ -54,9 +58,9 @@ def moments(indptr, indices, dx, dy, N, w, points, nodes, d_c, quadratic, b_indp
 @njit(cache=True, nogil=True)
 def corrected(indptr, indices, dx, dy, points, nodes, d_c, quadratic, c, out_x, out_y):
     """out_k[e] = d_k N[e] + q(x_p) . c[I, :, k] for every entry e = (p, I)."""
-    for p in range(len(indptr) - 1):
-        for e in range(indptr[p], indptr[p + 1]):
-            i = indices[e]
+    for p in range(uint64(len(indptr) - 1)):
+        for e in range(uint64(indptr[p]), uint64(indptr[p + _1])):
+            i = uint64(indices[e])
             cx = c[i, 0, 0]
             cy = c[i, 0, 1]
             if quadratic:

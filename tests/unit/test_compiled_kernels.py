@@ -255,3 +255,27 @@ def test_band_of_the_symmetric_part_is_filled_from_the_matrix_itself() -> None:
     stiffness_kernels.fill_lower_band(A.indptr, A.indices, A.data, rank, band, True)
     stiffness_kernels.fill_lower_band(S.indptr, S.indices, S.data, rank, ref, False)
     assert np.abs(band - ref).max() <= ROUNDOFF * np.abs(ref).max()
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_stress_recovery_of_both_paths_agrees_and_reproduces_its_polynomials(order: int, monkeypatch) -> None:
+    """The compiled recovery operator (many integration points) equals the numpy one to round-off, on a jittered
+    holed cloud whose boundary points have one-sided fits; both recover a field of the fit's order exactly."""
+    from ctmrpim.discretisation import stress_recovery
+    from ctmrpim.discretisation.alpha_shape import alpha_shape
+    from ctmrpim.discretisation.ctm import integration_points
+    geometry, nodes, d_c = cloud("plate-with-hole", jitter=0.3, seed=4)
+    boundary = alpha_shape(nodes, 1.5, d_c, inside=geometry.contains)
+    quad = integration_points(boundary.loop_coordinates(), d_c / 3, d_c / 3, 1, mode="uniform")
+    monkeypatch.setattr(stress_recovery, "COMPILED_MIN_POINTS", 0)
+    R1 = stress_recovery.recovery_operator(nodes, quad.points, quad.weights, d_c, order=order)
+    monkeypatch.setattr(stress_recovery, "COMPILED_MIN_POINTS", 10**12)
+    R0 = stress_recovery.recovery_operator(nodes, quad.points, quad.weights, d_c, order=order)
+    assert R1.nnz == R0.nnz
+    assert abs(R1 - R0).max() <= ROUNDOFF
+    x, y = quad.points.T
+    field = 3.0 + 2.0 * x - 5.0 * y + (0.7 * x * x - 1.1 * x * y + 0.4 * y * y if order == 2 else 0.0)
+    X, Y = nodes.T
+    exact = 3.0 + 2.0 * X - 5.0 * Y + (0.7 * X * X - 1.1 * X * Y + 0.4 * Y * Y if order == 2 else 0.0)
+    for R in (R0, R1):
+        assert np.abs(R @ field - exact).max() <= 1e3 * ROUNDOFF * np.abs(exact).max()
