@@ -141,12 +141,11 @@ def warm_up() -> None:
 
 
 def one_core_worker() -> None:
-    """A worker process computes on one core: one RPIM thread, one thread for the gradient products (BLAS is
-    limited per case)."""
-    from ctmrpim.discretisation import gradient_operator, rpim
+    """A worker process computes on one core: one thread for the compiled passes (RPIM, assembly, the gradient
+    products; BLAS is limited per case)."""
+    from ctmrpim.discretisation import thread_blocks
 
-    rpim.THREADS = 1
-    gradient_operator.THREADS = 1
+    thread_blocks.THREADS = 1
 
 
 @dataclass

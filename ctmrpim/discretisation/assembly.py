@@ -8,17 +8,15 @@ small systems are assembled by scipy's sparse products instead (the two agree to
 """
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
 import scipy.sparse as sp
 
 from ctmrpim.discretisation import rpim_kernels
 from ctmrpim.discretisation import stiffness_kernels as kernels
+from ctmrpim.discretisation.thread_blocks import run_blocks
 from ctmrpim.problem.model import Problem
 
-THREADS = 2            # blocks of node rows assembled concurrently
-ROW_BLOCK = 512        # node rows per kernel call on the thread pool
+ROW_BLOCK = 512        # node rows per kernel call on the threads (:mod:`ctmrpim.discretisation.thread_blocks`)
 #: below this many shape-function entries scipy's products are taken (numba's first kernel call in a
 #: process costs 0.2-0.45 s; :data:`ctmrpim.discretisation.rpim.COMPILED_MIN_POINTS`)
 COMPILED_MIN_ENTRIES = 300_000
@@ -58,9 +56,11 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     # symmetric K (Galerkin, symmetric D) on sorted rows: the upper blocks summed, the lower ones copied
     upper = test is None and np.array_equal(D, D.T) and dNdx.has_canonical_format
     run_blocks(lambda ab: kernels.stiffness_rows(indptr, indices, *data, w, Dc, tptr, trow, tent, n, node_start,
-                                                 neighbours, *ab, k_indices, k_data, upper), blocks)
+                                                 neighbours, *ab, k_indices, k_data, upper), blocks,
+               kernel=kernels.stiffness_rows)
     if upper:
-        run_blocks(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks)
+        run_blocks(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks,
+                   kernel=kernels.mirror_lower)
     K = sp.csr_matrix((k_data, k_indices, k_indptr), shape=(2 * n, 2 * n), copy=False)
     K.has_sorted_indices = True
     K.has_canonical_format = True
@@ -77,7 +77,7 @@ def node_pattern(indptr: np.ndarray, indices: np.ndarray, tptr: np.ndarray, trow
     def rows(ab: tuple[int, int]) -> None:
         parts[ab] = kernels.node_pattern_rows(indptr, indices, tptr, trow, n, *ab)
 
-    run_blocks(rows, blocks)
+    run_blocks(rows, blocks, kernel=kernels.node_pattern_rows)
     node_start = np.zeros(n + 1, np.int64)
     if blocks:
         np.cumsum(np.concatenate([parts[ab][0] for ab in blocks]), out=node_start[1:])
@@ -161,17 +161,6 @@ def _on_pattern(a: sp.csr_matrix, pattern: sp.csr_matrix) -> np.ndarray:
     out = np.zeros(pattern.nnz, dtype=a.dtype)
     out[np.searchsorted(key(pattern), key(a))] = a.data
     return out
-
-
-def run_blocks(work, blocks: list[tuple[int, int]]) -> None:
-    """``work(block)`` for every block, on a thread pool where there is more than one (the kernels release
-    the GIL)."""
-    if len(blocks) > 1 and THREADS > 1:
-        with ThreadPoolExecutor(max_workers=THREADS) as pool:
-            list(pool.map(work, blocks))
-    else:
-        for ab in blocks:
-            work(ab)
 
 
 def load_vector(N: sp.csr_matrix, weights: np.ndarray, tx: np.ndarray, ty: np.ndarray) -> np.ndarray:

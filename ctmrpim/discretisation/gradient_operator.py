@@ -8,7 +8,7 @@ Newton systems need two products, each step or iteration:
 
 As scipy products these are four passes over the matrix (two columns each way, CSR and its
 transpose); here each is one pass over the shared pattern with both derivative values, split into
-:data:`THREADS` blocks on a thread pool (the kernels release the GIL). The gradient runs over the points
+:data:`ctmrpim.discretisation.thread_blocks.THREADS` blocks on its threads (the kernels release the GIL). The gradient runs over the points
 (rows); the force over the nodes (columns), gathering from the pattern transposed once per operator, with
 its derivative values laid out in column order. Each node's force is summed over its points in an order
 fixed by the pattern (four interleaved partial sums in increasing point order): the sums do not depend on
@@ -18,39 +18,24 @@ a case gives the same bits on one core and on two.
 Why split: on the 1071-node column's 9600 points (about 413000 entries) the two passes were 2.3 of the
 5.4 ms of a step (Python's profile of a collapse run). Measured in one script on such a pattern, best of 300
 calls, one thread -> two: gradient 1.00 -> 0.81 ms, force 0.90 -> 0.53 ms (medians vary twofold on this shared
-machine). In a run the pattern (about 8 MB) is read from memory each time, and handing both blocks to the
-pool made the Newton iterations slower than one thread (waking two idle cores), hence the first block in the
-calling thread.
+machine). In a run the pattern (about 8 MB) is read from memory each time, and handing both blocks to a
+pool made the Newton iterations slower than one thread (waking two idle cores), hence the calling thread
+computes blocks too (:mod:`ctmrpim.discretisation.thread_blocks`).
 """
 from __future__ import annotations
-
-import os
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
 from numba import njit, uint64
 
+from ctmrpim.discretisation import thread_blocks
 from ctmrpim.discretisation.stiffness_kernels import transpose_pattern
 
-#: blocks of rows (gradient) or columns (force) computed concurrently; 1: all in the calling thread
-THREADS = 2
 #: below this many pattern entries one block does it: a pool's hand-over (tens of microseconds) would cost
 #: more than the second core saves
 PARALLEL_MIN_ENTRIES = 40_000
 _FAST = {"reassoc", "contract"}
 _1, _2, _3, _4 = uint64(1), uint64(2), uint64(3), uint64(4)
-
-_pool: tuple[int, ThreadPoolExecutor] | None = None
-
-
-def _executor() -> ThreadPoolExecutor:
-    """A thread pool kept for the process (the products run every step): made anew in a forked child, whose
-    copy of the parent's pool has no threads."""
-    global _pool
-    if _pool is None or _pool[0] != os.getpid():
-        _pool = (os.getpid(), ThreadPoolExecutor(max_workers=max(THREADS - 1, 1), thread_name_prefix="gradient"))
-    return _pool[1]
 
 
 def _blocks(starts: np.ndarray, parts: int) -> list[tuple[int, int]]:
@@ -60,16 +45,6 @@ def _blocks(starts: np.ndarray, parts: int) -> list[tuple[int, int]]:
     cuts = np.searchsorted(starts, np.linspace(0, starts[-1], parts + 1)[1:-1])
     edges = [0, *(int(c) for c in np.clip(cuts, 0, rows)), rows]
     return [(a, b) for a, b in zip(edges[:-1], edges[1:]) if b > a]
-
-
-def _run(kernel, args: tuple, blocks: list[tuple[int, int]]) -> None:
-    """``kernel(*args, *block)`` for every block: the first in the calling thread, the others on the pool (one
-    thread woken per call, not two: waking an idle core costs tens to hundreds of microseconds here)."""
-    futures = [_executor().submit(kernel, *args, *ab) for ab in blocks[1:]]
-    if blocks:
-        kernel(*args, *blocks[0])
-    for f in futures:
-        f.result()
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
@@ -127,7 +102,7 @@ class GradientOperator:
         self.shape = dNdx.shape
         self.indptr, self.indices = dNdx.indptr, dNdx.indices
         self.dx, self.dy = np.ascontiguousarray(dNdx.data, float), np.ascontiguousarray(dNdy.data, float)
-        parts = THREADS if len(self.indices) >= PARALLEL_MIN_ENTRIES else 1
+        parts = thread_blocks.THREADS if len(self.indices) >= PARALLEL_MIN_ENTRIES else 1
         self._row_blocks = _blocks(self.indptr, parts)
         self._pattern: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._columns: tuple[np.ndarray, np.ndarray, list[tuple[int, int]]] | None = None
@@ -150,20 +125,22 @@ class GradientOperator:
     def gradient(self, d: np.ndarray, identity: float = 1.0) -> np.ndarray:
         """(m, 4) F = I + grad d (xx, xy, yx, yy) of nodal displacements d (n, 2); ``identity = 0``: grad d."""
         out = np.empty((self.shape[0], 4))
-        _run(_gradient, (self.indptr, self.indices, self.dx, self.dy, np.ascontiguousarray(d, float), out,
-                         identity), self._row_blocks)
+        d = np.ascontiguousarray(d, float)
+        thread_blocks.run_blocks(lambda ab: _gradient(self.indptr, self.indices, self.dx, self.dy, d, out, identity,
+                                                      *ab), self._row_blocks, kernel=_gradient)
         return out
 
     def force(self, wP: np.ndarray) -> np.ndarray:
         """(n, 2) sum_p wP_p grad N of weighted first Piola stresses wP (m, 4: xX, xY, yX, yY)."""
         if self._columns is None:
             tptr, point, entry = self.transposed()
-            parts = THREADS if len(self.indices) >= PARALLEL_MIN_ENTRIES else 1
+            parts = thread_blocks.THREADS if len(self.indices) >= PARALLEL_MIN_ENTRIES else 1
             self._columns = (self.dx[entry], self.dy[entry], _blocks(tptr, parts))
         tptr, point, _ = self.transposed()
         tdx, tdy, blocks = self._columns
         out = np.empty((self.shape[1], 2))
-        _run(_force, (tptr, point, tdx, tdy, np.ascontiguousarray(wP, float), out), blocks)
+        wP = np.ascontiguousarray(wP, float)
+        thread_blocks.run_blocks(lambda ab: _force(tptr, point, tdx, tdy, wP, out, *ab), blocks, kernel=_force)
         return out
 
 

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ctmrpim.discretisation import assembly
+from ctmrpim.discretisation import assembly, thread_blocks
 from ctmrpim.discretisation import stiffness_kernels as kernels
 from ctmrpim.discretisation.gradient_operator import GradientOperator, from_blocks
 
@@ -40,7 +40,7 @@ class PointProducts:
         self._pattern: tuple[np.ndarray, np.ndarray] | None = None
         self.blocks = [(a, min(a + assembly.ROW_BLOCK, self.n)) for a in range(0, self.n, assembly.ROW_BLOCK)]
         # the tangent is rebuilt every Newton iteration, also on small clouds: its rows in one block per thread there
-        size = min(assembly.ROW_BLOCK, max(1, -(-self.n // assembly.THREADS)))
+        size = min(assembly.ROW_BLOCK, max(1, -(-self.n // thread_blocks.THREADS)))
         self.tangent_blocks = [(a, min(a + size, self.n)) for a in range(0, self.n, size)]
         self.sorted = _sorted_rows(trial.indptr, trial.indices)
 
@@ -80,7 +80,7 @@ class PointProducts:
                                           self.w, slot, Dc, *transposed, *ab, K.indptr, K.indices, K.data):
                 done[0] = False
 
-        assembly.run_blocks(rows, self.blocks)
+        thread_blocks.run_blocks(rows, self.blocks, kernel=kernels.pointwise_rows)
         return K if done[0] else None
 
     def tangent(self, A: np.ndarray) -> sp.csr_matrix:
@@ -99,11 +99,13 @@ class PointProducts:
         square = Ac.reshape(-1, 4, 4)
         upper = te is tr and self.sorted and bool(np.array_equal(square, square.transpose(0, 2, 1)))
         blocks = self.tangent_blocks
-        assembly.run_blocks(lambda ab: kernels.tangent_rows(tr.indptr, tr.indices, tr.dx, tr.dy, te.dx, te.dy, self.w,
-                                                            Ac, tptr, trow, tent, self.n, node_start, neighbours, *ab,
-                                                            k_indices, k_data, upper), blocks)
+        rows = lambda ab: kernels.tangent_rows(tr.indptr, tr.indices, tr.dx, tr.dy, te.dx, te.dy, self.w, Ac, tptr,
+                                               trow, tent, self.n, node_start, neighbours, *ab, k_indices, k_data,
+                                               upper)
+        thread_blocks.run_blocks(rows, blocks, kernel=kernels.tangent_rows)
         if upper:
-            assembly.run_blocks(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks)
+            thread_blocks.run_blocks(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks,
+                                     kernel=kernels.mirror_lower)
         K = sp.csr_matrix((k_data, k_indices, k_indptr), shape=(2 * self.n, 2 * self.n), copy=False)
         K.has_sorted_indices = True
         K.has_canonical_format = True

@@ -10,8 +10,8 @@ G^-1 times the column. Coordinates are local, centred at the evaluation point an
 shape functions do not change under this, and the conditioning is far better.
 
 The loops over the points are compiled (:mod:`ctmrpim.discretisation.rpim_kernels`): a count pass over
-a cell grid of the nodes sizes the CSR rows, then blocks of points, on a thread pool, each solve their
-systems one point at a time into those rows. Memory is the result plus one system per thread. Small
+a cell grid of the nodes sizes the CSR rows, then blocks of points, on the threads of
+:mod:`ctmrpim.discretisation.thread_blocks`, each solve their systems one point at a time into those rows. Memory is the result plus one system per thread. Small
 sets of points take a numpy path instead (numba's start-up would cost more than it saves): padded
 supports solved in batches by LAPACK, chunk by chunk. The two agree to round-off.
 
@@ -20,7 +20,6 @@ B^T D B products.
 """
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,10 +28,10 @@ from scipy.spatial import cKDTree
 
 from ctmrpim.blas_threads import one_blas_thread
 from ctmrpim.discretisation import rpim_kernels as kernels
+from ctmrpim.discretisation.thread_blocks import run_blocks
 from ctmrpim.errors import ProblemError
 
-BLOCK = 2048                 # points per kernel call on the thread pool
-THREADS = 2                  # blocks (compiled) or chunks (numpy) solved concurrently
+BLOCK = 2048                 # points per kernel call on the threads (:mod:`ctmrpim.discretisation.thread_blocks`)
 CHUNK = 128                  # numpy path: points per batched solve, (CHUNK, k+m, k+m) stays in cache
 #: below this many points the numpy path is taken: numba's first kernel call in a process costs about
 #: 0.2-0.45 s (its lowering registries load, cached kernels or not), and the compiled path saves about
@@ -123,18 +122,14 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
     indptr = np.zeros(n_pts + 1, itype)
     np.cumsum(kept, out=indptr[1:])
     indices = np.empty(nnz, itype)
-    values = np.empty((n_out, nnz))
+    # one array each (a row of one (n_out, nnz) array is a view that scipy copies for a CSR matrix's data)
+    values = tuple(np.empty(nnz) for _ in range(n_out)) + (np.empty(0),) * (3 - n_out)
     status = np.zeros(n_pts, np.int8)
     if n_pts:
         args = (nodes, *grid, points, radius, node_ref, point_ref, far2, use_ref, float(eta), m, float(scale),
                 n_out, PARTITION_OF_UNITY_TOL, indptr, indices, values, status)
         blocks = [(a, min(a + BLOCK, n_pts)) for a in range(0, n_pts, BLOCK)]
-        if len(blocks) > 1 and THREADS > 1:
-            with ThreadPoolExecutor(max_workers=THREADS) as pool:
-                list(pool.map(lambda ab: kernels.rpim_rows(*args, *ab), blocks))
-        else:  # one block (tractions, probes): no pool to start
-            for ab in blocks:
-                kernels.rpim_rows(*args, *ab)
+        run_blocks(lambda ab: kernels.rpim_rows(*args, *ab), blocks, kernel=kernels.rpim_rows)
     bad = status != kernels.OK
     if bad.any():
         if not drop_singular:
@@ -142,7 +137,7 @@ def shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius: float
         keep = np.repeat(~bad, kept)
         kept = np.where(bad, 0, kept)
         indptr[1:] = np.cumsum(kept)
-        indices, values = indices[keep], values[:, keep]
+        indices, values = indices[keep], tuple(v[keep] for v in values[:n_out])
     shape = (n_pts, len(nodes))
     mats = [_csr(values[j], indices, indptr, shape) for j in range(n_out)]
     if not derivatives:
@@ -216,19 +211,18 @@ def _numpy_shape_functions(nodes: np.ndarray, points: np.ndarray, support_radius
     order = np.argsort(counts, kind="stable")
     bounds = [(a, min(a + CHUNK, len(points))) for a in range(0, len(points), CHUNK)]
 
+    done: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+
     def work(ab):
         sel = order[ab[0]:ab[1]]
         ref = None if reference is None else (reference[0], reference[1][sel], reference[2])
-        return _chunk(nodes, points[sel], sel, tree, int(counts[sel].max()), radius[sel], eta, m, scale,
-                      derivatives, ref, drop_singular)
+        done[ab] = _chunk(nodes, points[sel], sel, tree, int(counts[sel].max()), radius[sel], eta, m, scale,
+                          derivatives, ref, drop_singular)
 
     # each small LAPACK solve runs on one thread; BLAS threads on top of ours would only contend
     with one_blas_thread():
-        if len(bounds) > 1 and THREADS > 1:
-            with ThreadPoolExecutor(max_workers=THREADS) as pool:
-                parts = list(pool.map(work, bounds))
-        else:  # one chunk (tractions, probes): no pool to start
-            parts = [work(b) for b in bounds]
+        run_blocks(work, bounds)
+    parts = [done[ab] for ab in bounds]
     shape = (len(points), len(nodes))
     if parts:
         indices = np.concatenate([p[0] for p in parts])

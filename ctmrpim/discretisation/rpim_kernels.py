@@ -300,8 +300,8 @@ def _moment_system(lx, ly, s_, m_, eta, half_odd, half_odd_d, n_out_, A, b, q):
 def rpim_rows(nodes, order, start, origin, h, ncx, ncy, points, radius, node_ref, point_ref, far2, use_ref,
               eta, m, scale, n_out, tol, indptr, indices, values, status, p0, p1):
     """Shape functions of the points p0 <= p < p1 into the CSR arrays (``indptr`` from the kept counts of
-    :func:`support_counts`): ``indices`` the support nodes in increasing order, ``values[0]`` phi (Eq. 33),
-    ``values[1:3]`` d phi / dx, dy when n_out = 3; ``status[p]`` OK, SINGULAR (zero pivot) or NOT_UNITY (the
+    :func:`support_counts`): ``indices`` the support nodes in increasing order, ``values`` three arrays: phi
+    (Eq. 33), and d phi / dx, dy when n_out = 3; ``status[p]`` OK, SINGULAR (zero pivot) or NOT_UNITY (the
     values do not sum to one within ``tol``, or are not finite: a numerically singular G).
 
     For each point the moment system of Eq. (32) is written in coordinates centred at the point and divided
@@ -352,8 +352,8 @@ def rpim_rows(nodes, order, start, origin, h, ncx, ncy, points, radius, node_ref
         o = indptr[p]
         for a in range(s):
             indices[o + a] = sup[a]
-            values[0, o + a] = b[0, a]
+            values[0][o + a] = b[0, a]
         if n_out == 3:
             for a in range(s):
-                values[1, o + a] = b[1, a] / scale
-                values[2, o + a] = b[2, a] / scale
+                values[1][o + a] = b[1, a] / scale
+                values[2][o + a] = b[2, a] / scale

@@ -8,6 +8,7 @@ import pytest
 import scipy.sparse as sp
 
 from ctmrpim.discretisation import gradient_operator as go
+from ctmrpim.discretisation import thread_blocks
 
 
 def _gradients(m: int, n: int, support: int, seed: int = 0) -> tuple[sp.csr_matrix, sp.csr_matrix]:
@@ -53,7 +54,7 @@ def test_the_bits_do_not_depend_on_the_threads(monkeypatch: pytest.MonkeyPatch) 
     d, wP = rng.normal(size=(500, 2)), rng.normal(size=(3000, 4))
     results = []
     for threads in (1, 2, 3):
-        monkeypatch.setattr(go, "THREADS", threads)
+        monkeypatch.setattr(thread_blocks, "THREADS", threads)
         op = go.GradientOperator(dx, dy)
         assert len(op._row_blocks) == threads
         results.append((op.gradient(d), op.force(wP)))
@@ -72,10 +73,31 @@ def test_the_force_is_a_scatter_in_point_order() -> None:
 
 
 def test_a_forked_process_gets_its_own_pool() -> None:
-    pool = go._executor()
-    assert go._executor() is pool
-    go._pool = (-1, pool)                 # as a forked child sees its parent's pool
+    pool = thread_blocks.executor()
+    assert thread_blocks.executor() is pool
+    thread_blocks._pool = (-1, pool)                 # as a forked child sees its parent's pool
     try:
-        assert go._executor() is not pool
+        assert thread_blocks.executor() is not pool
     finally:
-        go._pool = (go.os.getpid(), pool)
+        thread_blocks._pool = (thread_blocks.os.getpid(), pool)
+
+
+def test_blocks_run_once_each_and_an_error_in_one_is_raised(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every block once, whichever thread takes it, on 1, 2 and 3 threads; a failing block is raised, and the
+    blocks after it are not all started."""
+    for threads in (1, 2, 3):
+        monkeypatch.setattr(thread_blocks, "THREADS", threads)
+        seen: list[tuple[int, int]] = []
+        blocks = [(a, a + 1) for a in range(7)]
+        thread_blocks.run_blocks(seen.append, blocks)
+        assert sorted(seen) == blocks
+
+        def work(ab: tuple[int, int]) -> None:
+            if ab == (3, 4):
+                raise ValueError("block 3")
+            seen.append(ab)
+
+        seen.clear()
+        with pytest.raises(ValueError, match="block 3"):
+            thread_blocks.run_blocks(work, blocks)
+        assert (3, 4) not in seen and len(seen) < len(blocks)
