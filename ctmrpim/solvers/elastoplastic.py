@@ -43,7 +43,7 @@ def ctm_plastic_system(case: Case, timer: Timer) -> tuple[PlasticSystem, Configu
                            lambda factor: loads.forces(conf.x, factor)[0],
                            assembly.body_force_vector(conf.N, conf.w, problem), problem.material,
                            tangent=case.loading.tangent, test=test, dirichlet=dirichlet,
-                           products=PointProducts.build(conf.block_gradient(), test, conf.w))
+                           products=PointProducts.build(conf.block_gradient(), test, conf.w), nodes=conf.x)
     return system, conf, tags
 
 

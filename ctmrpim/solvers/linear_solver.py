@@ -7,9 +7,11 @@ Solvers (``method.solver``):
 
 * ``superlu``: SuperLU with the MMD_AT_PLUS_A ordering; measured, it is 4-6 times faster than scipy's
   default COLAMD ordering on these stiffness matrices (docs/design.md, 'Linear solvers').
-* ``banded``: reverse Cuthill-McKee ordering, then LAPACK's banded Cholesky (K is symmetric positive
-  definite once constrained; in mixed precision, below). On elongated bodies such as the cantilever the band is narrow and this
-  wins: 0.48 s against 0.76 s for SuperLU at 129 x 33 nodes, measured here.
+* ``banded``: the narrower band of the reverse Cuthill-McKee ordering and the dofs sorted along the body's
+  principal axis (:func:`ctmrpim.solvers.banded_lu.principal_axis_order`), then LAPACK's banded Cholesky (K is
+  symmetric positive definite once constrained; in mixed precision, below). On elongated bodies such as the
+  cantilever the band is narrow and this wins: 0.48 s against 0.76 s for SuperLU at 129 x 33 nodes, measured here
+  with the RCM band alone.
 * ``auto`` (default): ``banded`` when the band is at most BANDED_MAX_FRACTION of the dofs, else
   ``pardiso`` where pypardiso is installed and there are at least PARDISO_MIN_DOFS free dofs, else
   ``superlu``; a banded factorisation that finds K indefinite falls back to SuperLU, which then
@@ -57,8 +59,9 @@ from scipy.sparse.csgraph import reverse_cuthill_mckee
 from ctmrpim.blas_threads import one_blas_thread
 from ctmrpim.discretisation import assembly, rpim_kernels, stiffness_kernels
 from ctmrpim.errors import ProblemError
+from ctmrpim.solvers.banded_lu import principal_axis_order
 
-BANDED_MAX_FRACTION = 0.1   # auto: banded Cholesky when the RCM half-bandwidth is at most this share of the dofs
+BANDED_MAX_FRACTION = 0.1   # auto: banded Cholesky when the half-bandwidth is at most this share of the dofs
 KRYLOV_RTOL = 1e-11         # banded preconditioner: relative residual reached (SuperLU reaches 2-5e-12; the floor is 2e-12)
 KRYLOV_ITERATIONS, REFINEMENTS = 60, 4     # Krylov iterations per refinement, refinements at most
 KRYLOV_INNER_RTOL = 1e-6    # each refinement's relative residual (of its own right-hand side)
@@ -108,21 +111,22 @@ def solve_free(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, U: np.ndarra
     if not available(solver):
         raise ProblemError(f"method.solver = \"{solver}\" needs the optional package {OPTIONAL[solver]}: "
                            "pip install 'ctmrpim[solvers]'")
+    places = None if nodes is None else np.asarray(nodes, float)[free // 2]    # each free dof's node
     with one_blas_thread():
-        U[free] = _solve(Kff, rhs, solver, symmetric, lambda: _rigid_body_modes(nodes, free, U.size))
+        U[free] = _solve(Kff, rhs, solver, symmetric, lambda: _rigid_body_modes(nodes, free, U.size), places)
     if not np.all(np.isfinite(U)):
         raise ProblemError("the linear solve produced non-finite displacements: the stiffness matrix is singular")
     return U
 
 
 def _solve(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, solver: str, symmetric: bool,
-           modes: Callable[[], np.ndarray]) -> np.ndarray:
+           modes: Callable[[], np.ndarray], places: np.ndarray | None = None) -> np.ndarray:
     if solver == "spsolve":
         return spla.spsolve(Kff.tocsc(), rhs)
     if solver == "amg":
         return _amg(Kff, rhs, symmetric, modes())
     if solver in ("auto", "banded"):
-        if (x := _banded(Kff, rhs, solver == "banded", symmetric)) is not None:
+        if (x := _banded(Kff, rhs, solver == "banded", symmetric, places)) is not None:
             return x
     if solver == "pardiso" or (solver == "auto" and len(rhs) >= PARDISO_MIN_DOFS and available("pardiso")):
         return _pardiso(Kff, rhs, symmetric)
@@ -207,13 +211,15 @@ def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray
     return A, rhs
 
 
-def _banded(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool, symmetric: bool) -> np.ndarray | None:
-    """Solve A x = b on A's RCM band: a ``symmetric`` positive definite A by conjugate gradients on the single-
+def _banded(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool, symmetric: bool,
+            places: np.ndarray | None = None) -> np.ndarray | None:
+    """Solve A x = b on A's band (:func:`_band_order`): a ``symmetric`` positive definite A by conjugate gradients on the single-
     precision banded Cholesky factor (:func:`_refined`), else by the double-precision factor directly; a
     non-symmetric A by GMRES preconditioned with the factor of (A + A^T) / 2, single precision first
     (PRECONDITIONER_PRECISIONS). None when the band is too wide (auto, not ``always``), the factor's matrix is not
-    positive definite, or GMRES does not reach KRYLOV_RTOL with either factor."""
-    order = _band_order(A, always)
+    positive definite, or GMRES does not reach KRYLOV_RTOL with either factor. ``places`` (n, 2): where each row's
+    dof sits (:func:`_band_order`)."""
+    order = _band_order(A, always, places)
     if order is None:
         return None
     if not np.any(b):
@@ -265,24 +271,33 @@ def _refined(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, M: spla.LinearOper
     return None
 
 
-def _band_order(A: sp.csr_matrix | sp.csc_matrix, always: bool) -> tuple[np.ndarray, np.ndarray, int] | None:
-    """(RCM permutation, its inverse: the rank of each row, lower half-bandwidth) of A's symmetrised pattern;
+def _band_order(A: sp.csr_matrix | sp.csc_matrix, always: bool, places: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, int] | None:
+    """(permutation, its inverse: the rank of each row, lower half-bandwidth) of the narrower of two orderings of
+    A's symmetrised pattern: reverse Cuthill-McKee, and, where ``places`` (n, 2) says where each row's dof sits,
+    the rows sorted along the principal axis of those places (:func:`ctmrpim.solvers.banded_lu.principal_axis_order`);
     None when the band is wider than BANDED_MAX_FRACTION of the rows and not ``always``."""
-    perm = reverse_cuthill_mckee(A, symmetric_mode=True)
     n = A.shape[0]
-    rank = np.empty(n, np.int64)
-    rank[perm] = np.arange(n)
-    if rpim_kernels.use_compiled(A.nnz, assembly.COMPILED_MIN_ENTRIES):
-        bw = int(stiffness_kernels.lower_bandwidth(A.indptr, A.indices, rank))
-    else:
-        coo = A.tocoo()
-        bw = int(np.abs(rank[coo.row] - rank[coo.col]).max()) if A.nnz else 0
-    return None if not always and bw > BANDED_MAX_FRACTION * n else (perm, rank, bw)
+    candidates = [reverse_cuthill_mckee(A, symmetric_mode=True)]
+    if places is not None:
+        candidates.append(principal_axis_order(places))
+    best = None
+    for perm in candidates:
+        rank = np.empty(n, np.int64)
+        rank[perm] = np.arange(n)
+        if rpim_kernels.use_compiled(A.nnz, assembly.COMPILED_MIN_ENTRIES):
+            bw = int(stiffness_kernels.lower_bandwidth(A.indptr, A.indices, rank))
+        else:
+            coo = A.tocoo()
+            bw = int(np.abs(rank[coo.row] - rank[coo.col]).max()) if A.nnz else 0
+        if best is None or bw < best[2]:
+            best = (perm, rank, bw)
+    return None if not always and best[2] > BANDED_MAX_FRACTION * n else best
 
 
 def _band_factor(A: sp.csr_matrix | sp.csc_matrix, order: tuple[np.ndarray, np.ndarray, int], symmetric_part: bool,
                  dtype: type) -> tuple[np.ndarray, np.ndarray] | None:
-    """(RCM permutation, lower banded Cholesky factor in ``dtype``) of a symmetric A, or of (A + A^T) / 2 with
+    """(permutation, lower banded Cholesky factor in ``dtype``) of a symmetric A, or of (A + A^T) / 2 with
     ``symmetric_part``, in the ordering ``order`` (:func:`_band_order`); None when it is not positive definite
     (in that precision). The band of a large A is filled straight from its arrays (no permuted copies of A, no
     A^T; chosen by size, as the symmetric part's sums may differ from scipy's by round-off) and factorised in

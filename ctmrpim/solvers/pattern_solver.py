@@ -4,6 +4,8 @@ Cuthill-McKee band (:mod:`ctmrpim.solvers.banded_lu`, the layout found once per 
 against the rows, else by SuperLU (:mod:`ctmrpim.solvers.linear_solver`)."""
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -18,14 +20,15 @@ class PatternSolver:
     supports): the band's layout is found once per pattern and each tangent is one gather and one banded LU with
     partial pivoting (a non-symmetric tangent as it is); SuperLU where the band is not worthwhile."""
 
-    def __init__(self, n_dofs: int, fixed: np.ndarray) -> None:
+    def __init__(self, n_dofs: int, fixed: np.ndarray, nodes: Callable[[], np.ndarray] | None = None) -> None:
         self.fixed = fixed
         self.free = np.setdiff1d(np.arange(n_dofs), fixed)
         self.band: BandedLU | None = None
+        self.nodes = nodes          # () -> (n, 2) where the dofs sit now, for the band's ordering (None: unknown)
 
     def __call__(self, K: sp.csr_matrix, residual: np.ndarray) -> np.ndarray:
         if self.band is None or not self.band.fits(K):
-            self.band = BandedLU(K, self.free)
+            self.band = BandedLU(K, self.free, None if self.nodes is None else self.nodes())
         if not self.band.worthwhile:
             return solve_constrained(K, residual, self.fixed, np.zeros(len(self.fixed)), "superlu")
         du = np.zeros_like(residual)

@@ -105,6 +105,7 @@ class PlasticSystem:
     test: sp.bsr_matrix | None = None       # ctm-vci: G of the corrected test gradients (Petrov-Galerkin)
     dirichlet: Any = None                   # ctm-vci: its Dirichlet consistency term (RecoveredDirichletTerm)
     products: Any = None                    # compiled products over the points (CTM-RPIM's PointProducts), if any
+    nodes: np.ndarray | None = None         # (n, 2) where the dofs 2i, 2i + 1 sit, for the band's ordering, if known
 
     def __post_init__(self) -> None:
         self.GT = (self.G if self.test is None else self.test).T
@@ -264,7 +265,7 @@ class PlasticSystem:
         iteration of the elastic-stiffness iteration, and the band's substitution is about twice SuperLU's work
         (8.4 against 4.5 MFlop on the 1928-node slope)."""
         if banded and self._band is None:
-            band = BandedLU(self.elastic_stiffness(), self.free)
+            band = BandedLU(self.elastic_stiffness(), self.free, self.nodes)
             self._band = band if band.worthwhile else False
         if banded and self._band and self._band.fits(K):
             return self._band.factorise(K)
@@ -290,9 +291,8 @@ class PlasticSystem:
         Newton's trial iterates past a limit point long before the increment is judged, so the step of
         that iteration is taken with the elastic stiffness (regular once constrained, factorised once): the
         step the elastic-stiffness iteration (``tangent = "elastic"``) takes, slower to converge but never
-        singular. The next iteration tries the consistent tangent again, and the
-        increment converges, or is cut back as any other, by the load stepping's criteria. Counted in
-        ``safeguarded_steps``."""
+        singular. The next iteration tries the consistent tangent again, and the increment converges, or is cut
+        back as any other, by the load stepping's criteria. Counted in ``safeguarded_steps``."""
         self.safeguarded_steps += 1
         return self._solve_free(self._elastic_factors(), residual)
 

@@ -404,7 +404,7 @@ def solve_updated_lagrangian(case: Case) -> Result:
     series: list[dict] = []
 
     # the rate-form and follower tangents are not symmetric; a configuration's tangents share its pattern
-    solve = PatternSolver(2 * n, fixed)
+    solve = PatternSolver(2 * n, fixed, nodes=lambda: body.x)
 
     def probe_values() -> dict:
         u = body.material_x[:len(probes_X)] - probes_X
