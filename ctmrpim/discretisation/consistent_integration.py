@@ -242,6 +242,9 @@ class RecoveredDirichletTerm:
         Nn = sp.bsr_matrix((blocks, np.arange(b), np.arange(b + 1)), shape=(2 * b, 4 * b))
         R4 = sp.kron(recovery, sp.identity(4), format="csr")
         self.operator = (S @ Nn @ R4).tocsc()     # (2n x 4m): the points' stresses -> forces
+        #: (m,) the points whose stress reaches the term (those near the constrained edges): the others' part of
+        #: the tangent is zero, and its products need not run over them
+        self.reaches = np.diff(self.operator.indptr).reshape(-1, 4).any(axis=1)
 
     def force(self, P: np.ndarray) -> np.ndarray:
         """(2n,) the term's force of the stresses P (m, 4: xX, xY, yX, yY) at the integration points."""

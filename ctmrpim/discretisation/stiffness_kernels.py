@@ -254,54 +254,72 @@ def mirror_lower(k_indptr, k_indices, k_data, r0, r1):
 def pointwise_rows(indptr, indices, dx, dy, tdx, tdy, w, slot, D, tptr, trow, tent, r0, r1,
                    k_indptr, k_indices, k_data):
     """k_data += sum_p w_p B~_I^T D_p B_J over the points p with slot[p] >= 0 (D_p = D[slot[p]], any 3 x 3), for
-    the node rows r0 <= I < r1, on K's existing CSR pattern (k_indptr, k_indices: rows 2I and 2I + 1); (dx, dy)
-    the trial and (tdx, tdy) the test gradients on the points' pattern (indptr, indices), (tptr, trow, tent) its
-    transpose (:func:`transpose_pattern`). False where a block has no place in K's pattern (``k_data`` is then
-    partly updated: the caller works on a copy)."""
-    n2 = len(k_indptr) - 1
-    pos0 = np.full(n2, -1, np.int64)     # the entry of column c in row 2I, and in row 2I + 1
-    pos1 = np.full(n2, -1, np.int64)
+    the node rows r0 <= I < r1, on K's existing CSR pattern in the interleaved layout of :func:`stiffness_rows`
+    (rows 2I and 2I + 1 with the same columns, 2J and 2J + 1 side by side); (dx, dy) the trial and (tdx, tdy) the
+    test gradients on the points' pattern (indptr, indices), (tptr, trow, tent) its transpose
+    (:func:`transpose_pattern`). A row's sums gather in a dense accumulator by neighbour, with T = B~_I^T D_p (2 x 3)
+    once per point and node: 8 multiply-adds per pair instead of 16. False where K is not in that layout or a
+    block has no place in its pattern (``k_data`` is then partly updated: the caller works on a copy)."""
+    n = (len(k_indptr) - 1) // 2
+    pos = np.empty(n, np.uint32)
+    stamp = np.full(n, -1, np.int64)
+    width = 0
     for i in range(r0, r1):
+        width = max(width, k_indptr[2 * i + 1] - k_indptr[2 * i])
+    acc = np.empty(2 * width)
+    for i in range(uint64(r0), uint64(r1)):
         touched = False
-        for t in range(tptr[i], tptr[i + 1]):
-            if slot[trow[t]] >= 0:
+        for t in range(uint64(tptr[i]), uint64(tptr[i + _1])):
+            if slot[uint64(trow[t])] >= 0:
                 touched = True
                 break
         if not touched:
             continue
-        for k in range(k_indptr[2 * i], k_indptr[2 * i + 1]):
-            pos0[k_indices[k]] = k
-        for k in range(k_indptr[2 * i + 1], k_indptr[2 * i + 2]):
-            pos1[k_indices[k]] = k
-        for t in range(tptr[i], tptr[i + 1]):
-            p = trow[t]
+        a0, a1, a2 = uint64(k_indptr[_2 * i]), uint64(k_indptr[_2 * i + _1]), uint64(k_indptr[_2 * i + _2])
+        if (a1 - a0) % _2 != 0 or a2 - a1 != a1 - a0:
+            return False
+        c = (a1 - a0) // _2
+        for q in range(c):
+            col = k_indices[a0 + _2 * q]
+            if (col % 2 != 0 or k_indices[a0 + _2 * q + _1] != col + 1 or k_indices[a1 + _2 * q] != col
+                    or k_indices[a1 + _2 * q + _1] != col + 1):
+                return False
+            pos[col // 2] = q
+            stamp[col // 2] = i
+        for q in range(_4 * c):
+            acc[q] = 0.0
+        for t in range(uint64(tptr[i]), uint64(tptr[i + _1])):
+            p = uint64(trow[t])
             s = slot[p]
             if s < 0:
                 continue
-            e = tent[t]
+            e = uint64(tent[t])
             ax = tdx[e] * w[p]
             ay = tdy[e] * w[p]
-            d00, d01, d02 = D[s, 0, 0], D[s, 0, 1], D[s, 0, 2]
-            d10, d11, d12 = D[s, 1, 0], D[s, 1, 1], D[s, 1, 2]
-            d20, d21, d22 = D[s, 2, 0], D[s, 2, 1], D[s, 2, 2]
-            for k in range(indptr[p], indptr[p + 1]):
-                j = indices[k]
-                q00, q01, q10, q11 = pos0[2 * j], pos0[2 * j + 1], pos1[2 * j], pos1[2 * j + 1]
-                if q00 < 0 or q01 < 0 or q10 < 0 or q11 < 0:
+            # T = B~_I^T D_p with B~_I^T = [[ax, 0, ay], [0, ay, ax]]
+            t00 = ax * D[s, 0, 0] + ay * D[s, 2, 0]
+            t01 = ax * D[s, 0, 1] + ay * D[s, 2, 1]
+            t02 = ax * D[s, 0, 2] + ay * D[s, 2, 2]
+            t10 = ay * D[s, 1, 0] + ax * D[s, 2, 0]
+            t11 = ay * D[s, 1, 1] + ax * D[s, 2, 1]
+            t12 = ay * D[s, 1, 2] + ax * D[s, 2, 2]
+            for k in range(uint64(indptr[p]), uint64(indptr[p + _1])):
+                j = uint64(indices[k])
+                if stamp[j] != i:
                     return False
-                a = ax * dx[k]
-                b = ax * dy[k]
-                g = ay * dx[k]
-                h = ay * dy[k]
-                # B~_I^T D B_J with B = [[d/dx, 0], [0, d/dy], [d/dy, d/dx]], as in stiffness_rows
-                k_data[q00] += d00 * a + d02 * b + d20 * g + d22 * h
-                k_data[q01] += d01 * b + d02 * a + d21 * h + d22 * g
-                k_data[q10] += d10 * g + d12 * h + d20 * a + d22 * b
-                k_data[q11] += d11 * h + d12 * g + d21 * b + d22 * a
-        for k in range(k_indptr[2 * i], k_indptr[2 * i + 1]):
-            pos0[k_indices[k]] = -1
-        for k in range(k_indptr[2 * i + 1], k_indptr[2 * i + 2]):
-            pos1[k_indices[k]] = -1
+                q = _4 * uint64(pos[j])
+                bx = dx[k]
+                by = dy[k]
+                # T B_J with B_J = [[bx, 0], [0, by], [by, bx]]
+                acc[q] += t00 * bx + t02 * by
+                acc[q + _1] += t01 * by + t02 * bx
+                acc[q + _2] += t10 * bx + t12 * by
+                acc[q + _3] += t11 * by + t12 * bx
+        for q in range(c):
+            k_data[a0 + _2 * q] += acc[_4 * q]
+            k_data[a0 + _2 * q + _1] += acc[_4 * q + _1]
+            k_data[a1 + _2 * q] += acc[_4 * q + _2]
+            k_data[a1 + _2 * q + _1] += acc[_4 * q + _3]
     return True
 
 

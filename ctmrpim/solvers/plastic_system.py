@@ -16,10 +16,9 @@ scikit-fem reference use the same one, with the same material class and the same
 ``loading.tangent``:
 
 - ``"consistent"``: Newton on the consistent tangent, rebuilt every iteration as the elastic stiffness
-  plus a correction summed over the plastic points' rows of G only (footing: 84 s -> 54 s for the whole
-  run; a tangent still costs about 0.1 s and its factorisation 0.08 s at 1029 nodes, a residual
-  0.01 s). Reusing a stale plastic tangent (modified Newton) is unsafe: it is nearly singular in directions where the
-  current state is elastic, and the compressed Tresca block then diverges in its first increment.
+  plus a correction summed over the plastic points only (footing: 84 s -> 54 s for the whole run when it was
+  first done so). Reusing a stale plastic tangent (modified Newton) is unsafe: it is nearly singular in directions
+  where the current state is elastic, and the compressed Tresca block then diverges in its first increment.
   Where the consistent tangent is exactly singular (apex returns), that iteration's step is the elastic
   stiffness's (:meth:`PlasticSystem._safeguarded`);
 - ``"elastic"``: the elastic stiffness, assembled and factorised once for the whole analysis (it does
@@ -213,17 +212,18 @@ class PlasticSystem:
 
     def _plastic_tangent(self, plastic: np.ndarray, dD: np.ndarray) -> sp.csr_matrix:
         """K_elastic + the correction of the ``plastic`` points (k,) with D_ep - D = ``dD`` (k, 3, 3): by the compiled
-        point-wise pass of the ``products`` where there are (CTM-RPIM's), else, and with a Dirichlet consistency
-        term, by sparse products over the plastic points' rows of G."""
-        if self.products is not None and not self.consistent:
-            K = self.products.corrected(self._K_elastic, plastic, dD)
-            if K is not None:
-                return K
+        point-wise pass of the ``products`` where there are (CTM-RPIM's), else by sparse products over the plastic
+        points' rows of G; less a Dirichlet consistency term's part, over the points it reaches."""
         dA = TO_P[None] @ dD @ FROM_GRAD[None]
-        Gp = block_rows(self.G, plastic)
-        GTp = Gp.T if self.test is None else block_rows(self.test, plastic).T
-        K = self._K_elastic + tangent(Gp, dA, self.w[plastic], GTp)
-        return K - self.dirichlet.stiffness(Gp, dA, plastic) if self.consistent else K
+        K = None if self.products is None else self.products.corrected(self._K_elastic, plastic, dD)
+        if K is None:
+            Gp = block_rows(self.G, plastic)
+            GTp = Gp.T if self.test is None else block_rows(self.test, plastic).T
+            K = self._K_elastic + tangent(Gp, dA, self.w[plastic], GTp)
+        if not self.consistent:
+            return K
+        near = self.dirichlet.reaches[plastic]       # the plastic points whose stress the term recovers
+        return K - self.dirichlet.stiffness(block_rows(self.G, plastic[near]), dA[near], plastic[near])
 
     def solve(self, K: sp.csr_matrix, residual: np.ndarray) -> np.ndarray:
         """du (2n,) with K du = ``residual`` (2n,) at the free dofs and du = 0 at the fixed ones, reusing the LU
