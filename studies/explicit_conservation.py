@@ -93,8 +93,8 @@ class CorrectedForceRun(ExplicitRun):
                  loops: list[np.ndarray], triangles: np.ndarray) -> Configuration:
         frame = super().frame_at(x, free, points, w, loops, triangles)
         test = corrected_operator(frame, self)
-        # the frame's weights change in place (points the step inverts get 0): read them at each call
-        frame.force = lambda P: test.force(P * frame.w[:, None])
+        # the step hands over w P (the weights as they are now: points the step inverts get 0)
+        frame.weighted_force = test.force
         return frame
 
 

@@ -135,7 +135,11 @@ class Configuration:
 
     def force(self, P: np.ndarray) -> np.ndarray:
         """(n, 2) sum_p w_p P_p grad N of first Piola stresses P (m, 4: xX, xY, yX, yY) relative to ``x``."""
-        return self.compiled_gradient().force(P * self.w[:, None])
+        return self.weighted_force(P * self.w[:, None])
+
+    def weighted_force(self, wP: np.ndarray) -> np.ndarray:
+        """(n, 2) sum_p wP_p grad N of first Piola stresses already weighted, wP = w P (m, 4)."""
+        return self.compiled_gradient().force(wP)
 
 
 def build(x: np.ndarray, boundary: Boundary, points: np.ndarray, w: np.ndarray, lengths: ScaledMethod, *,

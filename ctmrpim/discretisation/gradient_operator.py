@@ -48,7 +48,8 @@ def _blocks(starts: np.ndarray, parts: int) -> list[tuple[int, int]]:
 
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
-def _gradient(indptr, indices, dx, dy, d, out, identity, p0, p1):
+def gradient_rows(indptr, indices, dx, dy, d, out, identity, p0, p1):
+    """out[p] = identity I + grad d at the points p0 <= p < p1 (xx, xy, yx, yy) of nodal displacements d (n, 2)."""
     # unsigned indices: a signed one is wrapped (i < 0 -> i + len) on every load, which keeps LLVM from
     # vectorising the sums (measured on the 1071-node column's pattern: 0.97 -> 0.41 ms per pass, one thread)
     for p in range(uint64(p0), uint64(p1)):
@@ -107,6 +108,11 @@ class GradientOperator:
         self._pattern: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._columns: tuple[np.ndarray, np.ndarray, list[tuple[int, int]]] | None = None
 
+    @property
+    def row_blocks(self) -> list[tuple[int, int]]:
+        """The blocks of points (rows) a pass over them is split into (about equal numbers of entries)."""
+        return self._row_blocks
+
     def transposed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(tptr (n + 1), point (nnz), entry (nnz)): the pattern by nodes, points ascending within a node
         (:func:`ctmrpim.discretisation.stiffness_kernels.transpose_pattern`), built once."""
@@ -126,8 +132,8 @@ class GradientOperator:
         """(m, 4) F = I + grad d (xx, xy, yx, yy) of nodal displacements d (n, 2); ``identity = 0``: grad d."""
         out = np.empty((self.shape[0], 4))
         d = np.ascontiguousarray(d, float)
-        thread_blocks.run_blocks(lambda ab: _gradient(self.indptr, self.indices, self.dx, self.dy, d, out, identity,
-                                                      *ab), self._row_blocks, kernel=_gradient)
+        thread_blocks.run_blocks(lambda ab: gradient_rows(self.indptr, self.indices, self.dx, self.dy, d, out,
+                                                          identity, *ab), self._row_blocks, kernel=gradient_rows)
         return out
 
     def force(self, wP: np.ndarray) -> np.ndarray:

@@ -26,8 +26,8 @@ from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import APEX, EIGEN_GAP, YIELD_TOL, MohrCoulomb
 from ctmrpim.materials.objective_stress import hughes_winget_components, rotate_components
 
-_hughes_winget = njit(cache=True)(hughes_winget_components)
-_rotate = njit(cache=True)(rotate_components)
+_hughes_winget = njit(cache=True, nogil=True)(hughes_winget_components)
+_rotate = njit(cache=True, nogil=True)(rotate_components)
 
 
 class PointUpdate(NamedTuple):
@@ -40,7 +40,7 @@ class PointUpdate(NamedTuple):
     viscous_work: float         # work of the last step's viscous stress on this step's strain
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _sorted_principal(sxx, syy, sxy, szz):
     """Sorted principal stresses s1 >= s2 >= s3, the in-plane unit eigenvector of the larger in-plane
     value and the slot of szz: :func:`ctmrpim.materials.mohr_coulomb._principal` for one real stress."""
@@ -65,7 +65,7 @@ def _sorted_principal(sxx, syy, sxy, szz):
     return big, small, szz, nx, ny, 2
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _return(s1, s2, s3, G, K, c, sphi, cphi, spsi):
     """Box 8.4 return of sorted principal trial stresses (perfect plasticity): main plane, right edge
     (s1 = s2), left edge (s2 = s3), apex; returns the stresses and the region (1-4)."""
@@ -98,7 +98,7 @@ def _return(s1, s2, s3, G, K, c, sphi, cphi, spsi):
     return apex, apex, apex, 4
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _trial_and_return(r0, r1, r2, r3, e0, e1, e2, lam, G, K, c, sphi, cphi, spsi):
     """The elastic trial stress from (r0, r1, r2, r3) (xx, yy, xy, zz) and the strain increment (e0, e1, e2) (exx,
     eyy, gxy; ezz = 0), returned to the yield surface where it lies outside (MohrCoulomb._update): the new stress
@@ -126,19 +126,22 @@ def _trial_and_return(r0, r1, r2, r3, e0, e1, e2, lam, G, K, c, sphi, cphi, spsi
     return t0, t1, t2, t3, reg
 
 
-@njit(cache=True)
-def _update(f, stress, plastic, viscous, dead, w, G, K, c, sphi, cphi, spsi, E, nu, beta_dt, out_stress, out_plastic,
-            out_viscous, region):
+@njit(cache=True, nogil=True)
+def update_rows(f, stress, plastic, viscous, dead, w, G, K, c, sphi, cphi, spsi, E, nu, beta_dt, out_stress,
+                out_plastic, out_viscous, region, dissipation, viscous_work, p0, p1):
+    """:func:`point_update` for the points p0 <= p < p1, each point's plastic dissipation and viscous work into
+    ``dissipation[p]`` and ``viscous_work[p]`` (summed by the caller, so that blocks of points on threads give the
+    same sums)."""
     lam = K - 2.0 * G / 3.0
-    dissipation = 0.0
-    viscous_work = 0.0
-    for p in range(f.shape[0]):
+    for p in range(p0, p1):
         if dead[p]:
             for k in range(4):
                 out_stress[p, k] = 0.0
                 out_plastic[p, k] = 0.0
                 out_viscous[p, k] = 0.0
             region[p] = 0
+            dissipation[p] = 0.0
+            viscous_work[p] = 0.0
             continue
         e0, e1, e2, cq, sq = _hughes_winget(f[p, 0], f[p, 1], f[p, 2], f[p, 3])
         r0, r1, r2 = _rotate(stress[p, 0], stress[p, 1], stress[p, 2], cq, sq)
@@ -151,7 +154,7 @@ def _update(f, stress, plastic, viscous, dead, w, G, K, c, sphi, cphi, spsi, E, 
         out_viscous[p, 1] = beta_dt * (lam * tr + 2.0 * G * e1)
         out_viscous[p, 2] = beta_dt * G * e2
         out_viscous[p, 3] = beta_dt * lam * tr
-        viscous_work += w[p] * (viscous[p, 0] * e0 + viscous[p, 1] * e1 + viscous[p, 2] * e2)
+        viscous_work[p] = w[p] * (viscous[p, 0] * e0 + viscous[p, 1] * e1 + viscous[p, 2] * e2)
         t0, t1, t2, t3, reg = _trial_and_return(r0, r1, r2, r3, e0, e1, e2, lam, G, K, c, sphi, cphi, spsi)
         region[p] = reg
         out_stress[p, 0], out_stress[p, 1], out_stress[p, 2], out_stress[p, 3] = t0, t1, t2, t3
@@ -164,8 +167,7 @@ def _update(f, stress, plastic, viscous, dead, w, G, K, c, sphi, cphi, spsi, E, 
         dp3 = -((1.0 + nu) * d3 - nu * trace) / E
         out_plastic[p, 0], out_plastic[p, 1] = q0 + dp0, q1 + dp1
         out_plastic[p, 2], out_plastic[p, 3] = q2 + dp2, q3 + dp3
-        dissipation += w[p] * 0.5 * ((r0 + t0) * dp0 + (r1 + t1) * dp1 + 2.0 * (r2 + t2) * dp2 + (r3 + t3) * dp3)
-    return dissipation, viscous_work
+        dissipation[p] = w[p] * 0.5 * ((r0 + t0) * dp0 + (r1 + t1) * dp1 + 2.0 * (r2 + t2) * dp2 + (r3 + t3) * dp3)
 
 
 def point_update(material: MohrCoulomb, f: np.ndarray, stress: np.ndarray, plastic: np.ndarray,
@@ -182,18 +184,18 @@ def point_update(material: MohrCoulomb, f: np.ndarray, stress: np.ndarray, plast
         raise ValueError("point_update: the tension cut-off is not compiled; use the numpy forms")
     m = len(f)
     out_stress, out_plastic, out_viscous = np.empty((m, 4)), np.empty((m, 4)), np.empty((m, 4))
-    region = np.empty(m, np.int8)
+    region, dissipation, viscous_work = np.empty(m, np.int8), np.empty(m), np.empty(m)
     phi, psi = math.radians(material.phi), math.radians(material.psi)
     viscous = np.zeros((m, 4)) if viscous is None else np.ascontiguousarray(viscous, float)
-    dissipation, viscous_work = _update(
-        np.ascontiguousarray(f, float), np.ascontiguousarray(stress, float), np.ascontiguousarray(plastic, float),
-        viscous, np.ascontiguousarray(dead, np.bool_), np.ascontiguousarray(w, float), material.G, material.K,
-        material.c, math.sin(phi), math.cos(phi), math.sin(psi), material.E, material.nu, float(beta_dt),
-        out_stress, out_plastic, out_viscous, region)
+    update_rows(np.ascontiguousarray(f, float), np.ascontiguousarray(stress, float), np.ascontiguousarray(plastic, float),
+                viscous, np.ascontiguousarray(dead, np.bool_), np.ascontiguousarray(w, float), material.G, material.K,
+                material.c, math.sin(phi), math.cos(phi), math.sin(psi), material.E, material.nu, float(beta_dt),
+                out_stress, out_plastic, out_viscous, region, dissipation, viscous_work, 0, m)
     if material.phi == 0 and np.any(region == APEX):
         raise ProblemError("Mohr-Coulomb return: a stress state beyond both edges with phi = 0 (no apex); the "
                            "strain increment is too large")
-    return PointUpdate(out_stress, out_plastic, region, float(dissipation), out_viscous, float(viscous_work))
+    return PointUpdate(out_stress, out_plastic, region, float(dissipation.sum()), out_viscous,
+                       float(viscous_work.sum()))
 
 
 @njit(cache=True)

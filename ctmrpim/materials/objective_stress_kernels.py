@@ -47,19 +47,45 @@ def relative(F_new, F, out):
 
 
 @njit(cache=True, nogil=True)
+def stretch_strain(F00, F01, F10, F11):
+    """|principal stretch - 1|, the larger of the two, of one gradient (xx, xy, yx, yy), from C = F^T F; NaN for a
+    gradient that is not finite."""
+    C00 = F00 ** 2 + F10 ** 2
+    C11 = F01 ** 2 + F11 ** 2
+    C01 = F00 * F01 + F10 * F11
+    mean, half = 0.5 * (C00 + C11), math.hypot(0.5 * (C00 - C11), C01)
+    low = mean - half
+    if low < 0.0:          # a NaN stays NaN, as under np.maximum
+        low = 0.0
+    big, small = math.sqrt(mean + half), math.sqrt(low)
+    if math.isnan(big) or math.isnan(small):
+        return math.nan
+    return max(abs(big - 1.0), abs(small - 1.0))
+
+
+@njit(cache=True, nogil=True)
 def largest_strain(F):
     """Largest |principal stretch - 1| over gradients F (m, 4), from C = F^T F; 0 for none."""
     big_out = 0.0
     for p in range(F.shape[0]):
-        C00 = F[p, 0] ** 2 + F[p, 2] ** 2
-        C11 = F[p, 1] ** 2 + F[p, 3] ** 2
-        C01 = F[p, 0] * F[p, 1] + F[p, 2] * F[p, 3]
-        mean, half = 0.5 * (C00 + C11), math.hypot(0.5 * (C00 - C11), C01)
-        low = mean - half
-        if low < 0.0:          # a NaN stays NaN, as under np.maximum
-            low = 0.0
-        big, small = math.sqrt(mean + half), math.sqrt(low)
-        if math.isnan(big) or math.isnan(small):
+        v = stretch_strain(F[p, 0], F[p, 1], F[p, 2], F[p, 3])
+        if math.isnan(v):
             return math.nan    # as numpy's max: a gradient that is not finite is no small strain
-        big_out = max(big_out, abs(big - 1.0), abs(small - 1.0))
+        big_out = max(big_out, v)
     return big_out
+
+
+@njit(cache=True, nogil=True)
+def weighted_first_piola(stress, viscous, with_viscous, F, w, out):
+    """out (m, 4) <- w P, P = det F (sigma + viscous) F^-T (xX, xY, yX, yY) (:func:`first_piola`), the viscous
+    stress added where ``with_viscous``: the explicit step's internal force density in one pass."""
+    for p in range(F.shape[0]):
+        sxx, syy, sxy = stress[p, 0], stress[p, 1], stress[p, 2]
+        if with_viscous:
+            sxx, syy, sxy = sxx + viscous[p, 0], syy + viscous[p, 1], sxy + viscous[p, 2]
+        F00, F01, F10, F11 = F[p, 0], F[p, 1], F[p, 2], F[p, 3]
+        wp = w[p]
+        out[p, 0] = (sxx * F11 - sxy * F01) * wp
+        out[p, 1] = (sxy * F00 - sxx * F10) * wp
+        out[p, 2] = (sxy * F11 - syy * F01) * wp
+        out[p, 3] = (syy * F00 - sxy * F10) * wp

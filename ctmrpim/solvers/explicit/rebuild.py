@@ -50,7 +50,8 @@ class Rebuilds:
         state kept as it is); once a point has been strained by more than ``relay_strain`` since the
         points were laid, the boundary is re-tracked and new CTM points laid, the state transferred."""
         s = self.settings
-        if largest_strain_c(self.F) <= s.rebuild_strain:
+        known = self.strain_of_F          # the step's point pass measured it on its way
+        if (known[1] if known is not None and known[0] is self.F else largest_strain_c(self.F)) <= s.rebuild_strain:
             return False
         old, F = self.frame, self.F
         w_now = old.w * det_c(F)

@@ -37,6 +37,7 @@ class RunState:
     plastic: np.ndarray             # (m, 4) plastic strain
     viscous: np.ndarray             # (m, 4) viscous stress of the last step
     F: np.ndarray                   # (m, 4) deformation gradient relative to the frame
+    strain_of_F: tuple[np.ndarray, float] | None = None   # (F, its largest stretch strain), as the step measured it
     laid: np.ndarray                # (m, 4) deformation gradient since the points were laid, up to the frame
     mode: np.ndarray                # (n, 2) the power iteration's vector (time step)
     dt: float                       # the time step

@@ -32,13 +32,15 @@ from __future__ import annotations
 import numpy as np
 
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb, plastic_strain_increment
-from ctmrpim.materials.mohr_coulomb_kernel import PointUpdate, point_update
-from ctmrpim.materials.objective_stress import det_c, first_piola_c, hughes_winget_c, relative_c, rotate_c
+from ctmrpim.materials.mohr_coulomb_kernel import PointUpdate
+from ctmrpim.materials.objective_stress import det_c, hughes_winget_c, relative_c, rotate_c
+from ctmrpim.materials.objective_stress_kernels import weighted_first_piola
 from ctmrpim.problem.model import Wall
 from ctmrpim.solvers.explicit.contact import enforce_walls
 from ctmrpim.solvers.explicit.energy import contract
 from ctmrpim.solvers.explicit.errors import Diverged
 from ctmrpim.solvers.explicit.frame import IDENTITY
+from ctmrpim.solvers.explicit.point_pass import point_pass
 
 #: More than this share of the integrating points inverted by one step: the step is unstable.
 INVERTED_LIMIT = 0.01
@@ -52,7 +54,9 @@ class CentralDifference:
     def advance(self, walls: list[Wall], damping: float) -> None:
         """One central-difference step from (x_n, v_{n-1/2}, stress_n) to (x_{n+1}, v_{n+1/2}, stress_{n+1})."""
         fr, dt, F = self.frame, self.dt, self.F
-        f_int = fr.force(first_piola_c(self.stress + self.viscous if self.settings.viscosity else self.stress, F))
+        wP = np.empty((len(fr.w), 4))
+        weighted_first_piola(self.stress, self.viscous, bool(self.settings.viscosity), F, fr.w, wP)
+        f_int = fr.weighted_force(wP)
         f = self.weight - f_int
         f_damp = -damping * np.abs(f) * np.sign(self.v) if damping else 0.0
         dv = dt * (f + f_damp) / self.mass[:, None]
@@ -75,30 +79,19 @@ class CentralDifference:
             e.walls += float(np.sum(self.mass[:, None] * (v - self.v - dv) * 0.5 * (v + self.v)))
         self.timer.lap("forces")
         x = self.x + dx
-        F_new = fr.gradient(x - fr.x)
-        f_inc = relative_c(F_new, F)
-        J = det_c(f_inc)
-        inverted = ~(J > 0) & (fr.w > 0)
-        if inverted.any():
-            # a point the step turns inside out: a few at a ragged front are dropped like the points
-            # without shape functions (weight 0, no stress, counted); many at once is an unstable step
-            if inverted.sum() > INVERTED_LIMIT * np.count_nonzero(fr.w):
-                i = int(np.argmin(np.where(inverted, np.where(np.isfinite(J), J, -np.inf), np.inf)))
-                p = fr.moved_points(x)[i]
-                raise Diverged(f"the step inverts the material at {int(inverted.sum())} integration points (det f = "
-                               f"{J[i]:.3g} at #{i} near ({p[0]:.5g}, {p[1]:.5g})) at step {self.step}, t = "
-                               f"{self.t:.6g} s; use a smaller explicit.dt or explicit.cfl")
-            fr.w[inverted] = 0.0
-            self.dropped_points += int(inverted.sum())
-        dead = ~(fr.w > 0)
-        if dead.any():
-            f_inc[dead], F_new[dead] = IDENTITY, IDENTITY
-        w = fr.w * det_c(F_new)
         if self.material.tension is None:
-            upd = point_update(self.material, f_inc, self.stress, self.plastic, dead, w, self.viscous,
-                               self.settings.viscosity / dt)
+            upd = point_pass(fr, x - fr.x, F, self.stress, self.plastic, self.viscous, self.material,
+                             self.settings.viscosity / dt)
+            self._drop_inverted(upd.inverted, x, F)
+            F_new, self.strain_of_F = upd.F, (upd.F, upd.largest_strain)
         else:
-            upd = point_update_numpy(self.material, f_inc, self.stress, self.plastic, dead, w)
+            F_new = fr.gradient(x - fr.x)
+            f_inc = relative_c(F_new, F)
+            self._drop_inverted(~(det_c(f_inc) > 0) & (fr.w > 0), x, F)
+            dead = ~(fr.w > 0)
+            if dead.any():
+                f_inc[dead], F_new[dead] = IDENTITY, IDENTITY
+            upd = point_update_numpy(self.material, f_inc, self.stress, self.plastic, dead, fr.w * det_c(F_new))
         if self.stage == "dynamic":
             self.energy.plastic += upd.dissipation
             self.energy.viscous += upd.viscous_work
@@ -107,6 +100,23 @@ class CentralDifference:
         self.stress, self.plastic, self.viscous = upd.stress, upd.plastic, upd.viscous
         self.t += dt
         self.step += 1
+
+    def _drop_inverted(self, inverted: np.ndarray, x: np.ndarray, F: np.ndarray) -> None:
+        """A point the step turns inside out (``inverted`` (m,)): a few at a ragged front are dropped like the points
+        without shape functions (weight 0, no stress, counted); many at once is an unstable step (x (n, 2) the
+        nodes after it, F (m, 4) the gradients before it, for the diagnosis)."""
+        if not inverted.any():
+            return
+        fr = self.frame
+        if inverted.sum() > INVERTED_LIMIT * np.count_nonzero(fr.w):
+            J = det_c(relative_c(fr.gradient(x - fr.x), F))
+            i = int(np.argmin(np.where(inverted, np.where(np.isfinite(J), J, -np.inf), np.inf)))
+            p = fr.moved_points(x)[i]
+            raise Diverged(f"the step inverts the material at {int(inverted.sum())} integration points (det f = "
+                           f"{J[i]:.3g} at #{i} near ({p[0]:.5g}, {p[1]:.5g})) at step {self.step}, t = "
+                           f"{self.t:.6g} s; use a smaller explicit.dt or explicit.cfl")
+        fr.w[inverted] = 0.0
+        self.dropped_points += int(inverted.sum())
 
 
 def point_update_numpy(material: MohrCoulomb, f_inc: np.ndarray, stress: np.ndarray, plastic: np.ndarray,
