@@ -6,14 +6,14 @@ Newton systems need two products, each step or iteration:
     F_p = I + sum_j (x_j - x_r,j) (dN_j/dx, dN_j/dy)(x_p)                        (the gradient)
     f_j = sum_p w_p P_p (dN_j/dx, dN_j/dy)(x_p)^T                              (the internal force)
 
-As scipy products these are four passes over the matrix (two columns each way, CSR and its
-transpose); here each is one pass over the shared pattern with both derivative values, split into
-:data:`ctmrpim.discretisation.thread_blocks.THREADS` blocks on its threads (the kernels release the GIL). The gradient runs over the points
-(rows); the force over the nodes (columns), gathering from the pattern transposed once per operator, with
-its derivative values laid out in column order. Each node's force is summed over its points in an order
-fixed by the pattern (four interleaved partial sums in increasing point order): the sums do not depend on
-the number of threads or the split, so a resumed explicit run repeats the uninterrupted one bit for bit, and
-a case gives the same bits on one core and on two.
+As scipy products these are four passes over the matrix (two columns each way, CSR and its transpose); here each is one
+pass over the shared pattern with both derivative values, split into
+:data:`ctmrpim.discretisation.thread_blocks.THREADS` blocks on its threads (the kernels release the GIL). The gradient
+runs over the points (rows); the force over the nodes (columns), gathering from the pattern transposed once per
+operator, with its derivative values laid out in column order. Each node's force is summed over its points in an order
+fixed by the pattern (four interleaved partial sums in increasing point order): the sums do not depend on the number of
+threads or the split, so a resumed explicit run repeats the uninterrupted one bit for bit, and a case gives the same
+bits on one core and on two.
 
 Why split: on the 1071-node column's 9600 points (about 413000 entries) the two passes were 2.3 of the
 5.4 ms of a step (Python's profile of a collapse run). Measured in one script on such a pattern, best of 300
@@ -103,8 +103,8 @@ class GradientOperator:
         self.shape = dNdx.shape
         self.indptr, self.indices = dNdx.indptr, dNdx.indices
         self.dx, self.dy = np.ascontiguousarray(dNdx.data, float), np.ascontiguousarray(dNdy.data, float)
-        parts = thread_blocks.THREADS if len(self.indices) >= PARALLEL_MIN_ENTRIES else 1
-        self._row_blocks = _blocks(self.indptr, parts)
+        self._parts = thread_blocks.THREADS if len(self.indices) >= PARALLEL_MIN_ENTRIES else 1
+        self._row_blocks = _blocks(self.indptr, self._parts)
         self._pattern: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._columns: tuple[np.ndarray, np.ndarray, list[tuple[int, int]]] | None = None
 
@@ -138,11 +138,9 @@ class GradientOperator:
 
     def force(self, wP: np.ndarray) -> np.ndarray:
         """(n, 2) sum_p wP_p grad N of weighted first Piola stresses wP (m, 4: xX, xY, yX, yY)."""
+        tptr, point, entry = self.transposed()
         if self._columns is None:
-            tptr, point, entry = self.transposed()
-            parts = thread_blocks.THREADS if len(self.indices) >= PARALLEL_MIN_ENTRIES else 1
-            self._columns = (self.dx[entry], self.dy[entry], _blocks(tptr, parts))
-        tptr, point, _ = self.transposed()
+            self._columns = (self.dx[entry], self.dy[entry], _blocks(tptr, self._parts))
         tdx, tdy, blocks = self._columns
         out = np.empty((self.shape[1], 2))
         wP = np.ascontiguousarray(wP, float)

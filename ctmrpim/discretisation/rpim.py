@@ -9,11 +9,11 @@ derivatives (three right-hand sides at once). G is symmetric, so the row vector 
 G^-1 times the column. Coordinates are local, centred at the evaluation point and scaled by d_c; the
 shape functions do not change under this, and the conditioning is far better.
 
-The loops over the points are compiled (:mod:`ctmrpim.discretisation.rpim_kernels`): a count pass over
-a cell grid of the nodes sizes the CSR rows, then blocks of points, on the threads of
-:mod:`ctmrpim.discretisation.thread_blocks`, each solve their systems one point at a time into those rows. Memory is the result plus one system per thread. Small
-sets of points take a numpy path instead (numba's start-up would cost more than it saves): padded
-supports solved in batches by LAPACK, chunk by chunk. The two agree to round-off.
+The loops over the points are compiled (:mod:`ctmrpim.discretisation.rpim_kernels`): a count pass over a cell grid of
+the nodes sizes the CSR rows, then blocks of points, on the threads of :mod:`ctmrpim.discretisation.thread_blocks`, each
+solve their systems one point at a time into those rows. Memory is the result plus one system per thread. Small sets of
+points take a numpy path instead (numba's start-up would cost more than it saves): padded supports solved in batches by
+LAPACK, chunk by chunk. The two agree to round-off.
 
 The result is stored as sparse rows (point -> support nodes, in increasing node order), ready for
 B^T D B products.

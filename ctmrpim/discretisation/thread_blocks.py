@@ -34,9 +34,10 @@ def executor() -> ThreadPoolExecutor:
 
 def run_blocks(work: Callable[[tuple[int, int]], Any], blocks: list[tuple[int, int]], kernel: Any = None) -> None:
     """``work(block)`` for every block, on THREADS threads (the calling one among them). An exception in a block
-    stops the handing out of blocks, and is raised here once the blocks already started have ended. ``kernel``: the numba dispatcher that ``work`` calls; where it
-    has not run in this process yet, the first block runs alone first, so that its cached code is loaded once
-    (two first calls at once load it twice: 15 ms each for the RPIM rows, measured)."""
+    stops the handing out of blocks, and is raised here once the blocks already started have ended. ``kernel``:
+    the numba dispatcher that ``work`` calls; where it has not run in this process yet, the first block runs alone
+    first, so that its cached code is loaded once (two first calls at once load it twice: 15 ms each for the RPIM
+    rows, measured)."""
     blocks = list(blocks)
     if kernel is not None and blocks and not getattr(kernel, "signatures", True):
         work(blocks.pop(0))

@@ -187,8 +187,9 @@ def point_update(material: MohrCoulomb, f: np.ndarray, stress: np.ndarray, plast
     region, dissipation, viscous_work = np.empty(m, np.int8), np.empty(m), np.empty(m)
     phi, psi = math.radians(material.phi), math.radians(material.psi)
     viscous = np.zeros((m, 4)) if viscous is None else np.ascontiguousarray(viscous, float)
-    update_rows(np.ascontiguousarray(f, float), np.ascontiguousarray(stress, float), np.ascontiguousarray(plastic, float),
-                viscous, np.ascontiguousarray(dead, np.bool_), np.ascontiguousarray(w, float), material.G, material.K,
+    update_rows(np.ascontiguousarray(f, float), np.ascontiguousarray(stress, float),
+                np.ascontiguousarray(plastic, float), viscous, np.ascontiguousarray(dead, np.bool_),
+                np.ascontiguousarray(w, float), material.G, material.K,
                 material.c, math.sin(phi), math.cos(phi), math.sin(psi), material.E, material.nu, float(beta_dt),
                 out_stress, out_plastic, out_viscous, region, dissipation, viscous_work, 0, m)
     if material.phi == 0 and np.any(region == APEX):

@@ -1,13 +1,12 @@
 """Banded LU (LAPACK dgbtrf) of tangents that share one sparsity pattern: the Mohr-Coulomb Newton iteration's, and
 the updated-Lagrangian iteration's within one configuration.
 
-Newton on the consistent tangent factorises a new matrix every iteration, always on the elastic stiffness's
-pattern (the plastic correction couples the nodes that already share a point). SuperLU orders and analyses each
-one afresh. Here the ordering (the narrower band of reverse Cuthill-McKee and, where the dofs' places are known,
-the sort along the body's principal axis: :func:`principal_axis_order`), the band and the place of every entry
-in LAPACK's band storage are found once from the pattern; each factorisation is one gather into the band and dgbtrf (partial
-pivoting within the band, so a non-symmetric tangent of non-associated flow is factorised as it is), on one BLAS
-thread.
+Newton on the consistent tangent factorises a new matrix every iteration, always on the elastic stiffness's pattern (the
+plastic correction couples the nodes that already share a point). SuperLU orders and analyses each one afresh. Here the
+ordering (the narrower band of reverse Cuthill-McKee and, where the dofs' places are known, the sort along the body's
+principal axis: :func:`principal_axis_order`), the band and the place of every entry in LAPACK's band storage are found
+once from the pattern; each factorisation is one gather into the band and dgbtrf (partial pivoting within the band, so a
+non-symmetric tangent of non-associated flow is factorised as it is), on one BLAS thread.
 
 Which wins depends on the rows' density. A meshfree row couples a node with about 140 others (286 entries
 per row at r_c = 4 d_c), which leaves a reverse Cuthill-McKee band only a small multiple of the row; a P2 row

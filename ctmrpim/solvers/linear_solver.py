@@ -213,8 +213,8 @@ def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray
 
 def _banded(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool, symmetric: bool,
             places: np.ndarray | None = None) -> np.ndarray | None:
-    """Solve A x = b on A's band (:func:`_band_order`): a ``symmetric`` positive definite A by conjugate gradients on the single-
-    precision banded Cholesky factor (:func:`_refined`), else by the double-precision factor directly; a
+    """Solve A x = b on A's band (:func:`_band_order`): a ``symmetric`` positive definite A by conjugate gradients
+    on the single-precision banded Cholesky factor (:func:`_refined`), else by the double-precision factor directly; a
     non-symmetric A by GMRES preconditioned with the factor of (A + A^T) / 2, single precision first
     (PRECONDITIONER_PRECISIONS). None when the band is too wide (auto, not ``always``), the factor's matrix is not
     positive definite, or GMRES does not reach KRYLOV_RTOL with either factor. ``places`` (n, 2): where each row's

@@ -1,21 +1,23 @@
 """The explicit step's pass over the integration points, compiled (numba): the gradient, the relative gradient and the
-Mohr-Coulomb update of every point in one loop (Section 2.1.4, steps 7-9; :mod:`ctmrpim.solvers.explicit.step`).
+Mohr-Coulomb update of every point, block by block (Section 2.1.4, steps 7-9; :mod:`ctmrpim.solvers.explicit.step`).
 
 Per point p, from the nodes' displacements d = x - x_r since the frame was built:
 
     F_new = I + sum_j d_j grad_r N_j(x_p),   f = F_new F^-1,   det f > 0 or the point is inverted,
 
-the weight w_r det F_new and the largest stretch strain of F_new, which the rebuild criterion reads; then, for the
-block while its gradients are in cache, the stress update of :func:`ctmrpim.materials.mohr_coulomb_kernel.update_rows`
-(Hughes-Winget rotation, return, plastic strain, viscous stress). A point without weight, or inverted by the step, integrates nothing: identity gradients,
-no stress (the caller drops the inverted ones' weights, or stops the run where there are too many).
+the weight w_r det F_new and the largest stretch strain of F_new, which the rebuild criterion reads; then, for the block
+while its gradients are in cache, the stress update of :func:`ctmrpim.materials.mohr_coulomb_kernel.update_rows`
+(Hughes-Winget rotation, return, plastic strain, viscous stress). A point without weight, or inverted by the step,
+integrates nothing: identity gradients, no stress (the caller drops the inverted ones' weights, or stops the run where
+there are too many).
 
 Why one pass: as separate products and numpy expressions these were a gradient pass over the ~8 MB shape-function
 pattern, eight array passes over the points' (m, 4) gradients and weights, the update kernel and the strain
-criterion's pass, each reading and writing the points' arrays anew; here each point's data is read once and stays in
-registers, and blocks of points run on the threads of :mod:`ctmrpim.discretisation.thread_blocks`. The plastic
-dissipation and viscous work are kept per point and added up afterwards, so the run's numbers do not depend on the
-threads or the blocks (a resumed run repeats the uninterrupted one bit for bit).
+criterion's pass, each over all the points, the update on one thread; here a block of points goes through three
+simple loops one after the other while it is in cache (one loop doing all three vectorised worse), and the blocks run
+on the threads of :mod:`ctmrpim.discretisation.thread_blocks`. The plastic dissipation and viscous work are kept per
+point and added up afterwards, so the run's numbers do not depend on the threads or the blocks (a resumed run repeats
+the uninterrupted one bit for bit).
 """
 from __future__ import annotations
 
