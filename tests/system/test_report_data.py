@@ -183,13 +183,36 @@ def test_every_number_of_the_report_is_read_from_its_tables() -> None:
                        f"--quick`); per section, (in the report only, from the tables only): {stale}")
 
 
-def test_the_prose_types_no_number() -> None:
+#: the tables' columns of measured results (errors, times, deposit measures, brackets, balances), not the parameters
+#: and references the sections select or compare by
+MEASURED = re.compile(r"error|time_s|_s$|per_step|run_out_m|height_at|dev_m|dist_m|slope_deg|steepest|^fs_|"
+                      r"limit_(carried|failed)|sxx|rel_diff|balance|share|drift")
+
+
+def _perturbed(reports: Path, into: Path, factor: float = 1.0137) -> Path:
+    """A copy of the committed tables under ``reports`` (and its ``full/``) with every measured cell (:data:`MEASURED`)
+    multiplied by ``factor``: the numbers the data sets then come out otherwise, the typed ones do not."""
+    for csv in [*reports.glob("*.csv"), *reports.glob("full/*.csv")]:
+        target = into / csv.relative_to(reports)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        table = pd.read_csv(csv)
+        floats = [c for c in table.select_dtypes("float").columns if MEASURED.search(c) and "measured" not in c]
+        table[floats] = table[floats] * factor
+        table.to_csv(target, index=False)
+    return into
+
+
+def test_the_prose_types_no_number(tmp_path: Path) -> None:
     """No number of the prose, re-rendered from the committed tables, stands as a literal in the Python sources,
-    unless it is a reference value of the tolerances table (the paper's and the analytical values live there)."""
+    unless it is a reference value of the tolerances table (the paper's and the analytical values live there). A
+    number the data sets is not typed, whatever constant of the code it happens to equal (a collapse run of 150 s,
+    a deposit 10.0 mm from the measured line): only the numbers that stay when the tables' measured values move
+    by 1.4 % are looked for in the sources."""
     if not (REPORTS / "node_density.csv").is_file():
         pytest.skip("no committed tables")
     text, _ = render()
-    found = set(numbers(prose(text)))
+    moved, _ = render(_perturbed(REPORTS, tmp_path))
+    found = set(numbers(prose(text))) & set(numbers(prose(moved)))
     sources = "\n".join(f.read_text(errors="ignore") for d in ("ctmrpim", "studies", "reference_fem")
                         for f in (ROOT / d).rglob("*.py"))
     typed = {n for n in found if re.search(r"(?<![\w.])" + re.escape(n) + r"(?![\w.])", sources)}
