@@ -39,12 +39,23 @@ def extra(summary: dict, folder: Path) -> dict:
     states = read_pvd(Path(folder) / "result.pvd")
     first, last = meshio.read(states[0][1]), meshio.read(states[-1][1])
     u = last.point_data["u"][:, :2]
-    crest = np.argmin(np.hypot(first.points[:, 0] - 20.0, first.points[:, 1] - 15.0))
+    top = crest_point()
+    crest = np.argmin(np.hypot(first.points[:, 0] - top[0], first.points[:, 1] - top[1]))
     return {"folder": str(folder), "end_time_s": dyn["end_time"], "steps": dyn["steps"], "rebuilds": dyn["rebuilds"],
             "re_layings": dyn["state_transfers"], "max_displacement_m": float(np.linalg.norm(u, axis=1).max()),
             "crest_settlement_m": float(-u[crest, 1]), "toe_advance_m": float(u[:, 0].max()),
             "plastic_dissipation_J": dyn["energy"]["plastic_dissipation"],
             "ms_per_step": 1e3 * dyn["seconds_per_step"]["total"]}
+
+
+def crest_point() -> np.ndarray:
+    """(2,) the slope's crest: the end of its top surface above the slope face (the vertex of the benchmark's
+    outer loop with the largest ordinate, the farthest along x of those)."""
+    from ctmrpim import benchmarks
+
+    vertices = benchmarks.load("slope-slide").problem.geometry.loops()[0]
+    top = vertices[vertices[:, 1] == vertices[:, 1].max()]
+    return top[np.argmax(top[:, 0])]
 
 
 def figure(df: pd.DataFrame) -> Figure:

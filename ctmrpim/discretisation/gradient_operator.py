@@ -16,11 +16,12 @@ threads or the split, so a resumed explicit run repeats the uninterrupted one bi
 bits on one core and on two.
 
 Why split: on the 1071-node column's 9600 points (about 413000 entries) the two passes were 2.3 of the
-5.4 ms of a step (Python's profile of a collapse run). Measured in one script on such a pattern, best of 300
-calls, one thread -> two: gradient 1.00 -> 0.81 ms, force 0.90 -> 0.53 ms (medians vary twofold on this shared
-machine). In a run the pattern (about 8 MB) is read from memory each time, and handing both blocks to a
-pool made the Newton iterations slower than one thread (waking two idle cores), hence the calling thread
-computes blocks too (:mod:`ctmrpim.discretisation.thread_blocks`).
+5.4 ms of a step (Python's profile of a collapse run) before they were compiled with unsigned indices and the
+force in partial sums; measured now in one script on such a pattern, one thread, best of 50 calls: gradient
+0.41 ms, force 0.40 ms (medians vary twofold on this shared machine). In a run the pattern (about 8 MB) is
+read from memory each time, and handing both blocks to a pool made the Newton iterations slower than one
+thread (waking two idle cores), hence the calling thread computes blocks too
+(:mod:`ctmrpim.discretisation.thread_blocks`).
 """
 from __future__ import annotations
 
