@@ -211,7 +211,7 @@ def _rpow_row(q, out, n, eta, half_odd):
 
 
 @njit(cache=True, nogil=True)
-def _support(nodes, order, start, origin, h, ncx, ncy, p, px, py, r, node_ref, point_ref, far2, use_ref, sup):
+def support_nodes(nodes, order, start, origin, h, ncx, ncy, p, px, py, r, node_ref, point_ref, far2, use_ref, sup):
     """The nodes within r of (px, py) (and, with use_ref, within sqrt(far2) of point p in the reference
     configuration) into sup, in increasing order; their number."""
     r2 = r * r
@@ -325,7 +325,7 @@ def rpim_rows(nodes, order, start, origin, h, ncx, ncy, points, radius, node_ref
     half_odd_d = half_odd - 1 if half_odd >= 1 else -1    # r^(eta - 2) of an odd eta >= 3 by multiplication too
     for p in range(p0, p1):
         px, py = points[p, 0], points[p, 1]
-        s = _support(nodes, order, start, origin, h, ncx, ncy, p, px, py, radius[p], node_ref, point_ref, far2,
+        s = support_nodes(nodes, order, start, origin, h, ncx, ncy, p, px, py, radius[p], node_ref, point_ref, far2,
                      use_ref, sup)
         if s == 0:
             status[p] = SINGULAR

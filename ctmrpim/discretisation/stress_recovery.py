@@ -130,8 +130,8 @@ def _recovery_rows(points, order, start, origin, h, ncx, ncy, weights, at, rho, 
     none = np.zeros((1, 2))
     for i in range(len(at)):
         xi, yi, r = at[i, 0], at[i, 1], rho[i]
-        s = rpim_kernels._support(points, order, start, origin, h, ncx, ncy, i, xi, yi, r, none, none, 0.0, False,
-                                  sup)
+        s = rpim_kernels.support_nodes(points, order, start, origin, h, ncx, ncy, i, xi, yi, r, none, none, 0.0,
+                                       False, sup)
         for a in range(terms):
             e[0, a] = 0.0
             for b in range(terms):

@@ -21,15 +21,16 @@ from typing import Any, Callable
 #: threads of a pass (the calling thread and THREADS - 1 from the pool); 1: all in the calling thread
 THREADS = 2
 
-_pool: tuple[int, ThreadPoolExecutor] | None = None
+_pool: tuple[int, int, ThreadPoolExecutor] | None = None     # (process, threads, pool)
 
 
 def executor() -> ThreadPoolExecutor:
-    """The process's pool of THREADS - 1 threads (at least one), made anew in a forked child."""
+    """The process's pool of THREADS - 1 threads (at least one), made anew in a forked child or when THREADS grew."""
     global _pool
-    if _pool is None or _pool[0] != os.getpid() or _pool[1]._max_workers < THREADS - 1:
-        _pool = (os.getpid(), ThreadPoolExecutor(max_workers=max(THREADS - 1, 1), thread_name_prefix="blocks"))
-    return _pool[1]
+    if _pool is None or _pool[0] != os.getpid() or _pool[1] < THREADS - 1:
+        size = max(THREADS - 1, 1)
+        _pool = (os.getpid(), size, ThreadPoolExecutor(max_workers=size, thread_name_prefix="blocks"))
+    return _pool[2]
 
 
 def run_blocks(work: Callable[[tuple[int, int]], Any], blocks: list[tuple[int, int]], kernel: Any = None) -> None:

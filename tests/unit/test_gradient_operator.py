@@ -75,11 +75,12 @@ def test_the_force_is_a_scatter_in_point_order() -> None:
 def test_a_forked_process_gets_its_own_pool() -> None:
     pool = thread_blocks.executor()
     assert thread_blocks.executor() is pool
-    thread_blocks._pool = (-1, pool)                 # as a forked child sees its parent's pool
+    pid, size, _ = thread_blocks._pool
+    thread_blocks._pool = (-1, size, pool)               # as a forked child sees its parent's pool
     try:
         assert thread_blocks.executor() is not pool
     finally:
-        thread_blocks._pool = (thread_blocks.os.getpid(), pool)
+        thread_blocks._pool = (pid, size, pool)
 
 
 def test_blocks_run_once_each_and_an_error_in_one_is_raised(monkeypatch: pytest.MonkeyPatch) -> None:
