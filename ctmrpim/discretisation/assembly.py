@@ -12,6 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ctmrpim.discretisation import rpim_kernels
+from ctmrpim.discretisation.gradient_correction import GradientCorrection
 from ctmrpim.discretisation import stiffness_kernels as kernels
 from ctmrpim.discretisation.thread_blocks import run_blocks
 from ctmrpim.problem.model import Problem
@@ -28,16 +29,22 @@ def dof(node: np.ndarray, component: int) -> np.ndarray:
 
 
 def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: np.ndarray,
-              test: tuple[sp.csr_matrix, sp.csr_matrix] | None = None) -> sp.csr_matrix:
+              test: tuple[sp.csr_matrix, sp.csr_matrix] | GradientCorrection | None = None) -> sp.csr_matrix:
     """K (2n x 2n) = sum_p B~_p^T D B_p w_p (Eq. 5) from the derivatives ``dNdx``, ``dNdy`` (m, n) at m points
     with ``weights`` (m,), for one constant D (3, 3). B~ is built from the ``test`` gradients (d~N/dx, d~N/dy)
     where given (Petrov-Galerkin, not symmetric: :mod:`ctmrpim.discretisation.consistent_integration`), else
     B~ = B. All matrices must share one sparsity pattern. K's pattern is every pair of nodes that share a
-    point (an entry that sums to zero is kept); its column indices are sorted."""
+    point (an entry that sums to zero is kept); its column indices are sorted. ``test`` may also be the
+    correction's coefficients (:class:`GradientCorrection`), which the compiled kernel adds to the trial gradients
+    as it reads them (the corrected arrays are never held)."""
     m, n = dNdx.shape
-    tdx, tdy = test if test is not None else (dNdx, dNdy)
+    compiled = rpim_kernels.use_compiled(dNdx.nnz, COMPILED_MIN_ENTRIES)
+    correction = test if isinstance(test, GradientCorrection) else None
+    if correction is not None and not compiled:
+        test, correction = correction.applied(dNdx, dNdy), None
+    tdx, tdy = test if test is not None and correction is None else (dNdx, dNdy)
     axes = D[0, 2] == 0 and D[1, 2] == 0 and D[2, 0] == 0 and D[2, 1] == 0
-    if axes and np.array_equal(D, D.T) and not rpim_kernels.use_compiled(dNdx.nnz, COMPILED_MIN_ENTRIES):
+    if axes and np.array_equal(D, D.T) and not compiled:
         return _stiffness_products(dNdx, dNdy, weights, D, test)
     for M in (dNdy, tdx, tdy):
         same = M.indices is dNdx.indices or (np.array_equal(M.indices, dNdx.indices))
@@ -55,8 +62,10 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     k_indices, k_data, k_indptr = interleaved_arrays(node_start)
     # symmetric K (Galerkin, symmetric D) on sorted rows: the upper blocks summed, the lower ones copied
     upper = test is None and np.array_equal(D, D.T) and dNdx.has_canonical_format
+    corr = (correction.c, correction.points, correction.nodes, correction.d_c, correction.mode) if correction \
+        else (np.zeros((1, 3, 2)), np.zeros((1, 2)), np.zeros((1, 2)), 1.0, 0)
     run_blocks(lambda ab: kernels.stiffness_rows(indptr, indices, *data, w, Dc, tptr, trow, tent, n, node_start,
-                                                 neighbours, *ab, k_indices, k_data, upper), blocks,
+                                                 neighbours, *ab, k_indices, k_data, upper, *corr), blocks,
                kernel=kernels.stiffness_rows)
     if upper:
         run_blocks(lambda ab: kernels.mirror_lower(k_indptr, k_indices, k_data, *ab), blocks,

@@ -35,6 +35,7 @@ import scipy.sparse as sp
 
 from ctmrpim.discretisation import assembly, rpim_kernels, vci_kernels
 from ctmrpim.discretisation.ctm import BoundaryQuadrature, boundary_points
+from ctmrpim.discretisation.gradient_correction import GradientCorrection
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator, value_operator
 from ctmrpim.discretisation.rpim import ShapeFunctions
 from ctmrpim.discretisation.stress_recovery import recovery_operator
@@ -58,12 +59,14 @@ def boundary_quadrature(nodes: np.ndarray, edges: np.ndarray) -> BoundaryQuadrat
 
 
 def corrected_gradients(nodes: np.ndarray, d_c: float, points: np.ndarray, w: np.ndarray, sf: ShapeFunctions,
-                        boundary: BoundaryQuadrature, N_boundary: sp.csr_matrix, order: str
-                        ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+                        boundary: BoundaryQuadrature, N_boundary: sp.csr_matrix, order: str,
+                        as_correction: bool = False) -> tuple[sp.csr_matrix, sp.csr_matrix] | GradientCorrection:
     """The test gradients d~N/dx, d~N/dy (m, n; the pattern of ``sf``) at the m ``points`` (m, 2) with area
     weights ``w`` (m,), for which the integration constraints of ``order`` ("linear" or "quadratic") hold
     against the ``boundary`` Gauss points, where ``N_boundary`` (b, n) are the shape functions. ``nodes``
-    (n, 2), ``d_c`` the node spacing (it scales q). A node in no point's support keeps its gradients."""
+    (n, 2), ``d_c`` the node spacing (it scales q). A node in no point's support keeps its gradients.
+    ``as_correction``: on the compiled path (large sets), the coefficients (:class:`GradientCorrection`) instead of
+    the two arrays, for :func:`ctmrpim.discretisation.assembly.stiffness` to apply as it sums."""
     dx, dy, N = sf.dNdx, sf.dNdy, sf.N
     if not rpim_kernels.use_compiled(dx.nnz, assembly.COMPILED_MIN_ENTRIES):
         return _numpy_corrected_gradients(nodes, d_c, points, w, sf, boundary, N_boundary, order)
@@ -86,10 +89,8 @@ def corrected_gradients(nodes: np.ndarray, d_c: float, points: np.ndarray, w: np
     else:
         total = M[:, 0, 0]
         c[:, 0, :] = R[:, 0, :] / np.where(total > 0, total, 1.0)[:, None]
-    out_x, out_y = np.empty(dx.nnz), np.empty(dx.nnz)
-    vci_kernels.corrected(indptr, indices, f64(dx.data), f64(dy.data), points, nodes, float(d_c), quadratic, c,
-                          out_x, out_y)
-    return tuple(sp.csr_matrix((v, d.indices, d.indptr), shape=d.shape) for v, d in ((out_x, dx), (out_y, dy)))
+    correction = GradientCorrection(c, points, nodes, float(d_c), quadratic)
+    return correction if as_correction else correction.applied(dx, dy)
 
 
 def _numpy_corrected_gradients(nodes: np.ndarray, d_c: float, points: np.ndarray, w: np.ndarray, sf: ShapeFunctions,
@@ -132,20 +133,22 @@ def _numpy_corrected_gradients(nodes: np.ndarray, d_c: float, points: np.ndarray
                                shape=d.shape) for k, d in enumerate((dx, dy)))
 
 
-def corrected_test_gradients(conf: Configuration, method: Method, thickness: float
-                             ) -> tuple[BoundaryQuadrature, ShapeFunctions, sp.csr_matrix, sp.csr_matrix]:
+def corrected_test_gradients(conf: Configuration, method: Method, thickness: float, as_correction: bool = False
+                             ) -> tuple[BoundaryQuadrature, ShapeFunctions, sp.csr_matrix | GradientCorrection,
+                                        sp.csr_matrix | None]:
     """What every solver path with ``method.integration = "ctm-vci"`` starts from, on a configuration ``conf``
     integrated over its tracked node loops: the boundary's Gauss points, the shape functions there and the
-    corrected test gradients d~N/dx, d~N/dy at the configuration's points (weights without the ``thickness``)."""
+    corrected test gradients d~N/dx, d~N/dy at the configuration's points (weights without the ``thickness``).
+    ``as_correction``: where :func:`corrected_gradients` gives the coefficients, they come third and None fourth."""
     if method.boundary != "alpha":
         raise ProblemError("method.integration = \"ctm-vci\" integrates over the node loops of the tracked boundary: "
                            "set method.boundary = \"alpha\", or method.integration = \"ctm\" for the paper's scheme",
                            key="method.integration")
     boundary = boundary_quadrature(conf.x, conf.boundary.edges)
     sf_b = conf.shape_functions_at(boundary.points)
-    test_dx, test_dy = corrected_gradients(conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf,
-                                           boundary, sf_b.N, method.correction)
-    return boundary, sf_b, test_dx, test_dy
+    test = corrected_gradients(conf.x, conf.lengths.d_c, conf.points, conf.w / thickness, conf.sf, boundary, sf_b.N,
+                               method.correction, as_correction)
+    return (boundary, sf_b, test, None) if isinstance(test, GradientCorrection) else (boundary, sf_b, *test)
 
 
 def dirichlet_consistency(n_nodes: int, fixed: np.ndarray, boundary: BoundaryQuadrature, sf: ShapeFunctions,

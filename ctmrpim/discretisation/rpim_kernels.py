@@ -8,12 +8,14 @@ of one point's size, an LU factorisation with partial pivoting and the two trian
 shape functions written straight into the CSR arrays. Nothing larger than one point's system exists at a
 time, so the memory is the result's (the CSR rows) plus a few kB per thread.
 
-The LU eliminates two pivot columns per pass over the trailing matrix (the second column is brought up to
-date before its pivot is chosen, so the pivot sequence is that of ordinary partial pivoting): half the
-loads and stores of one column at a time. G is symmetric, so its rows are its columns and the LU works on
-them column-major (every inner loop contiguous) with unsigned indices, which lets LLVM vectorise it: 11.7 ->
-6.5 us per 50 x 50 system, and a point's shape functions 23 -> 14 us in all on the 129 x 33 cantilever
-(one thread, this project's two-core machine). The kernels release the GIL, so
+The LU eliminates four pivot columns per pass over the trailing matrix (each column of the four is brought up
+to date by the ones before it before its pivot is chosen, so the pivot sequence is that of ordinary partial
+pivoting): a quarter of the loads and stores of one column at a time. G is symmetric, so its rows are its
+columns and the LU works on them column-major (every inner loop contiguous) with unsigned indices, which lets
+LLVM vectorise it: 11.7 -> 6.5 us per 50 x 50 system with two columns per pass, and a point's shape functions
+23 -> 14 us in all on the 129 x 33 cantilever; four columns per pass, 12.0 -> 10.9 us per point (one thread,
+this project's two-core machine; the support search 0.4 us, G and the right-hand sides 2.3 us, the LU and the
+substitutions 7.9 us of it). The kernels release the GIL, so
 :func:`ctmrpim.discretisation.rpim.shape_functions` runs blocks of points on a thread pool.
 
 The fast-math flags are limited to contraction and reassociation (round-off only): no-NaN/no-Inf flags
@@ -32,7 +34,7 @@ _FAST = {"contract", "reassoc"}
 #: status of a point after :func:`rpim_rows`
 OK, SINGULAR, NOT_UNITY = 0, 1, 2
 #: unsigned index constants: numba compiles ``k + 1`` of an unsigned k as a float unless 1 is unsigned too
-_0, _1, _2 = np.uint64(0), np.uint64(1), np.uint64(2)
+_0, _1, _2, _3, _4 = (np.uint64(v) for v in range(5))
 
 
 def numba_ready() -> bool:
@@ -132,18 +134,58 @@ def _pivot(C, b, k, j0, n, nr):
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
 def lu_solve(C, b, n_, nr_):
-    """Solve A x = b in place (x in b) by LU with partial pivoting, two pivot columns per pass over the
-    trailing matrix: C (n, n) holds A column by column (C[j, i] = A[i, j]; a symmetric A is its own C) and
+    """Solve A x = b in place (x in b) by LU with partial pivoting, four pivot columns per pass over the
+    trailing matrix (then two, then one, for the last columns): C (n, n) holds A column by column (C[j, i] = A[i, j]; a symmetric A is its own C) and
     is overwritten; b (nr, n) holds the right-hand sides as rows. Returns False where a pivot is exactly zero
     (singular).
 
-    Column-major, every inner loop runs down a contiguous column (pivot search, multipliers, the rank-2
-    update of each trailing column, the right-hand sides, the column-oriented back substitution); only the
+    Column-major, every inner loop runs down a contiguous column (pivot search, multipliers, the rank-4
+    (rank-2) update of each trailing column, the right-hand sides, the column-oriented back substitution); only the
     row swaps are strided. Every index is unsigned: numba wraps a signed index that may be negative
     (``i < 0`` -> ``i + len``), and that select keeps LLVM from vectorising the loops. Measured on 50 x 50
     moment systems in cache here: 11.7 us per system row by row with signed indices, 6.5 us so."""
     n, nr = np.uint64(n_), np.uint64(nr_)
     k = _0
+    while k + _3 < n:                              # four pivot columns per pass over the trailing matrix
+        c0 = C[k]
+        for c in range(k, k + _4):
+            cc = C[c]
+            for q in range(k, c):                  # column c brought up to date by the panel's earlier columns
+                u = cc[q]
+                cq = C[q]
+                for i in range(q + _1, n):
+                    cc[i] -= cq[i] * u
+            if _pivot(C, b, c, k, n, nr) == 0.0:   # (swaps the rows of the panel's multipliers too)
+                return False
+            inv = 1.0 / cc[c]
+            for i in range(c + _1, n):
+                cc[i] *= inv
+        k1, k2, k3, k4 = k + _1, k + _2, k + _3, k + _4
+        c1, c2, c3 = C[k1], C[k2], C[k3]
+        l10, l20, l21, l30, l31, l32 = c0[k1], c0[k2], c1[k2], c0[k3], c1[k3], c2[k3]
+        for j in range(k4, n):
+            cj = C[j]
+            u0 = cj[k]
+            u1 = cj[k1] - l10 * u0
+            u2 = cj[k2] - l20 * u0 - l21 * u1
+            u3 = cj[k3] - l30 * u0 - l31 * u1 - l32 * u2
+            cj[k1] = u1
+            cj[k2] = u2
+            cj[k3] = u3
+            for i in range(k4, n):
+                cj[i] -= c0[i] * u0 + c1[i] * u1 + c2[i] * u2 + c3[i] * u3
+        for j in range(nr):
+            bj = b[j]
+            u0 = bj[k]
+            u1 = bj[k1] - l10 * u0
+            u2 = bj[k2] - l20 * u0 - l21 * u1
+            u3 = bj[k3] - l30 * u0 - l31 * u1 - l32 * u2
+            bj[k1] = u1
+            bj[k2] = u2
+            bj[k3] = u3
+            for i in range(k4, n):
+                bj[i] -= c0[i] * u0 + c1[i] * u1 + c2[i] * u2 + c3[i] * u3
+        k = k4
     while k + _1 < n:
         if _pivot(C, b, k, k, n, nr) == 0.0:
             return False

@@ -83,14 +83,16 @@ def node_pattern_rows(indptr, indices, tptr, trow, n, r0, r1):
 
 @njit(cache=True, nogil=True, fastmath=_FAST)
 def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n, node_start, neighbours, r0, r1,
-                   k_indices, k_data, upper):
+                   k_indices, k_data, upper, corr, points, nodes, d_c, mode):
     """Rows 2I and 2I + 1 of K for r0 <= I < r1 into the interleaved CSR arrays: node row I owns
     4 node_start[I] .. 4 node_start[I + 1] (its c neighbours ``neighbours[node_start[I]:node_start[I + 1]]``,
     sorted: row 2I first, 2c entries, then row 2I + 1), columns 2J, 2J + 1 for J ascending. (dx, dy) the trial
     and (tdx, tdy) the test gradients on the pattern (indptr, indices), w the points' weights, D (3, 3).
     ``upper``: K symmetric (B~ = B, D symmetric) and the pattern's rows sorted: only the blocks J >= I are summed
     and written (the entries after I's in a point's row are those), half the work; :func:`mirror_lower` writes
-    the rest."""
+    the rest. ``mode`` 1 or 2: the test gradients are (tdx, tdy) plus the correction of
+    :class:`ctmrpim.discretisation.gradient_correction.GradientCorrection` (coefficients ``corr`` (n, 3, 2), linear
+    or quadratic, at ``points`` over ``nodes``, scaled by ``d_c``), as its ``applied`` writes them; 0: as given."""
     pos = np.empty(n, np.uint32)
     width = 0
     for i in range(r0, r1):
@@ -106,11 +108,25 @@ def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n,
             pos[uint64(neighbours[o + q])] = q
         for q in range(_4 * c):
             acc[q] = 0.0
+        if mode > 0:
+            cx0, cx1, cx2 = corr[i, 0, 0], corr[i, 1, 0], corr[i, 2, 0]
+            cy0, cy1, cy2 = corr[i, 0, 1], corr[i, 1, 1], corr[i, 2, 1]
+            xi, yi = nodes[i, 0], nodes[i, 1]
         for t in range(uint64(tptr[i]), uint64(tptr[i + _1])):
             p = uint64(trow[t])
             e = uint64(tent[t])
-            ax = tdx[e] * w[p]
-            ay = tdy[e] * w[p]
+            if mode == 0:
+                ax = tdx[e] * w[p]
+                ay = tdy[e] * w[p]
+            else:
+                cx, cy = cx0, cy0
+                if mode == 2:
+                    q1 = (points[p, 0] - xi) / d_c
+                    q2 = (points[p, 1] - yi) / d_c
+                    cx += q1 * cx1 + q2 * cx2
+                    cy += q1 * cy1 + q2 * cy2
+                ax = (tdx[e] + cx) * w[p]
+                ay = (tdy[e] + cy) * w[p]
             for k in range(e if upper else uint64(indptr[p]), uint64(indptr[p + _1])):
                 q = _4 * uint64(pos[uint64(indices[k])])
                 bx = dx[k]

@@ -157,6 +157,32 @@ def test_corrected_gradients_meet_the_integration_constraints(order: str) -> Non
             assert np.abs(lhs - rhs).max() <= 1e3 * ROUNDOFF * max(np.abs(rhs).max(), 1.0)
 
 
+@pytest.mark.parametrize("order", ["linear", "quadratic"])
+def test_stiffness_from_the_correction_coefficients_is_that_of_the_corrected_arrays(order: str, monkeypatch) -> None:
+    """K summed with the correction added entry by entry in the kernel (GradientCorrection) equals K from the
+    corrected gradients as arrays, to round-off; on the numpy path the coefficients are applied first."""
+    from ctmrpim.discretisation.alpha_shape import alpha_shape
+    from ctmrpim.discretisation.ctm import integration_points
+    from ctmrpim.discretisation.gradient_correction import GradientCorrection
+    geometry, nodes, d_c = cloud("plate-with-hole", jitter=0.3, seed=7)
+    boundary = alpha_shape(nodes, 1.5, d_c, inside=geometry.contains)
+    quad = integration_points(boundary.loop_coordinates(), d_c / 3, d_c / 3, 1, mode="uniform")
+    bq = boundary_quadrature(nodes, boundary.edges)
+    sf = shape_functions(nodes, quad.points, 4 * d_c, 5.0, 3, d_c)
+    Nb = shape_functions(nodes, bq.points, 4 * d_c, 5.0, 3, d_c, derivatives=False).N
+    D = np.array([[3.0, 1.2, 0.1], [0.9, 2.5, -0.2], [0.05, 0.1, 1.0]])     # general D: every term of the kernel
+    correction = corrected_gradients(nodes, d_c, quad.points, quad.weights, sf, bq, Nb, order, as_correction=True)
+    assert isinstance(correction, GradientCorrection)
+    arrays = corrected_gradients(nodes, d_c, quad.points, quad.weights, sf, bq, Nb, order)
+    K_arrays = assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights, D, test=arrays)
+    K_coefficients = assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights, D, test=correction)
+    assert abs(K_arrays - K_coefficients).max() <= ROUNDOFF * abs(K_arrays).max()
+    assert abs(K_arrays - assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights, D)).max() > 1e-3 * abs(K_arrays).max()
+    _numpy_paths(monkeypatch)
+    K_numpy = assembly.stiffness(sf.dNdx, sf.dNdy, quad.weights, D, test=correction)
+    assert abs(K_arrays - K_numpy).max() <= ROUNDOFF * abs(K_arrays).max()
+
+
 def test_shape_function_memory_is_the_result_plus_a_little(jittered) -> None:
     """Nothing of size points x support x support: the traced peak stays within twice the CSR rows' size."""
     nodes, _, d_c = jittered
