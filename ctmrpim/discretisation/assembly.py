@@ -12,8 +12,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ctmrpim.discretisation import rpim_kernels
-from ctmrpim.discretisation.gradient_correction import GradientCorrection
 from ctmrpim.discretisation import stiffness_kernels as kernels
+from ctmrpim.discretisation.gradient_correction import GradientCorrection
 from ctmrpim.discretisation.thread_blocks import run_blocks
 from ctmrpim.problem.model import Problem
 
