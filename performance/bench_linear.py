@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import resource
 import subprocess
 import sys
@@ -83,18 +84,25 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--grids", default=DEFAULT_GRIDS, help="comma-separated NXxNY (default %(default)s)")
     ap.add_argument("--repeat", type=int, default=3, help="solves per case (the largest grid: 2 at most)")
-    ap.add_argument("--methods", default=",".join(m[0] for m in METHODS))
+    ap.add_argument("--methods", default=",".join(m[0] for m in METHODS),
+                    help="comma-separated, of: %(default)s")
     ap.add_argument("--csv")
     ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.child:
         child(a.child[0], a.child[1], int(a.child[2]))
         return
+    labels = a.methods.split(",")
+    unknown = [m for m in labels if m not in {m[0] for m in METHODS}]
+    if unknown:
+        ap.error(f"unknown method(s) {', '.join(unknown)}: choose from {', '.join(m[0] for m in METHODS)}")
     grids = a.grids.split(",")
+    if not all(re.fullmatch(r"[1-9][0-9]*x[1-9][0-9]*", g) for g in grids):
+        ap.error(f"--grids {a.grids!r}: expected NXxNY[,NXxNY...], e.g. 33x9,129x33")
     sizes = [int(g.split("x")[0]) * int(g.split("x")[1]) for g in grids]
     rows = []
     for g, size in zip(grids, sizes, strict=True):
-        for label in a.methods.split(","):
+        for label in labels:
             rows.append(run_case(g, label, min(a.repeat, 2) if size > 10000 else a.repeat))
             r = rows[-1]
             phases = "  ".join(f"{k[2:]} {v:.3f}" for k, v in r.items() if k.startswith("t_") and k != "t_total")

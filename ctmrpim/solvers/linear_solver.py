@@ -57,9 +57,14 @@ import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ctmrpim.blas_threads import one_blas_thread
-from ctmrpim.discretisation import assembly, rpim_kernels, stiffness_kernels
+from ctmrpim.discretisation import assembly, rpim_kernels
 from ctmrpim.errors import ProblemError
+from ctmrpim.solvers import free_block_kernels
 from ctmrpim.solvers.banded_lu import principal_axis_order
+from ctmrpim.solvers.symmetric_half import SymmetricHalf
+
+#: a free block as the solvers take it
+Matrix = sp.csr_matrix | sp.csc_matrix | SymmetricHalf
 
 BANDED_MAX_FRACTION = 0.1   # auto: banded Cholesky when the half-bandwidth is at most this share of the dofs
 KRYLOV_RTOL = 1e-11         # banded preconditioner: relative residual reached (SuperLU reaches 2-5e-12; the floor is 2e-12)
@@ -73,6 +78,8 @@ ITERATIVE_RTOL = 1e-11      # amg: relative residual of CG / GMRES, as KRYLOV_RT
 ITERATIVE_MAXITER = 2000    # amg: iterations before it is refused
 #: the optional solvers and the package each needs (``pip install 'ctmrpim[solvers]'``)
 OPTIONAL = {"pardiso": "pypardiso", "amg": "pyamg"}
+#: the solvers that work on a symmetric free block's upper triangle (:class:`SymmetricHalf`) without the whole
+HALF_SOLVERS = ("auto", "banded", "pardiso")
 
 
 def available(solver: str) -> bool:
@@ -91,20 +98,22 @@ def solve_constrained(K: sp.csr_matrix, F: np.ndarray, fixed: np.ndarray, values
     return solve_free(*constrained_system(K, F, fixed, values), solver, symmetric, nodes)
 
 
-def constrained_system(K: sp.csr_matrix, F: np.ndarray, fixed: np.ndarray, values: np.ndarray
-                       ) -> tuple[sp.csr_matrix | sp.csc_matrix, np.ndarray, np.ndarray, np.ndarray]:
+def constrained_system(K: sp.csr_matrix, F: np.ndarray, fixed: np.ndarray, values: np.ndarray,
+                       half: bool = False
+                       ) -> tuple[Matrix, np.ndarray, np.ndarray, np.ndarray]:
     """The system of the free dofs: (K_ff, F_f - K_fc values, U with the prescribed values and zeros
     elsewhere, the free dofs). A caller that drops K before :func:`solve_free` keeps one copy of the
-    stiffness, not two, while it is factorised."""
+    stiffness, not two, while it is factorised. With ``half`` (a symmetric K with sorted columns, to be solved
+    by one of HALF_SOLVERS), a large K_ff is its upper triangle (:class:`SymmetricHalf`): half the memory."""
     n = K.shape[0]
     U = np.zeros(n)
     U[fixed] = values
     free = np.setdiff1d(np.arange(n), fixed)
-    Kff, rhs = _free_block(K, F, free, U)
+    Kff, rhs = _free_block(K, F, free, U, half)
     return Kff, rhs, U, free
 
 
-def solve_free(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, U: np.ndarray, free: np.ndarray,
+def solve_free(Kff: Matrix, rhs: np.ndarray, U: np.ndarray, free: np.ndarray,
                solver: str = "superlu", symmetric: bool = True, nodes: np.ndarray | None = None) -> np.ndarray:
     """U with U[free] solving Kff U[free] = rhs (:func:`constrained_system`), by ``solver`` (``symmetric``:
     whether Kff is; ``nodes``: as for :func:`solve_constrained`)."""
@@ -119,8 +128,13 @@ def solve_free(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, U: np.ndarra
     return U
 
 
-def _solve(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, solver: str, symmetric: bool,
+def _solve(Kff: Matrix, rhs: np.ndarray, solver: str, symmetric: bool,
            modes: Callable[[], np.ndarray], places: np.ndarray | None = None) -> np.ndarray:
+    if isinstance(Kff, SymmetricHalf):
+        if not symmetric:
+            raise ValueError("a SymmetricHalf is the free block of a symmetric K only")
+        if solver not in HALF_SOLVERS:
+            Kff = Kff.full()
     if solver == "spsolve":
         return spla.spsolve(Kff.tocsc(), rhs)
     if solver == "amg":
@@ -130,6 +144,8 @@ def _solve(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, solver: str, sym
             return x
     if solver == "pardiso" or (solver == "auto" and len(rhs) >= PARDISO_MIN_DOFS and available("pardiso")):
         return _pardiso(Kff, rhs, symmetric)
+    if isinstance(Kff, SymmetricHalf):   # auto, where neither the band nor PARDISO took it
+        Kff = Kff.full()
     try:
         lu = spla.splu(Kff.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                        options={"SymmetricMode": True})
@@ -139,14 +155,15 @@ def _solve(Kff: sp.csr_matrix | sp.csc_matrix, rhs: np.ndarray, solver: str, sym
     return lu.solve(rhs)
 
 
-def _pardiso(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, symmetric: bool) -> np.ndarray:
+def _pardiso(A: Matrix, b: np.ndarray, symmetric: bool) -> np.ndarray:
     """A^-1 b by PARDISO: positive definite on A's upper triangle where A is symmetric, else real non-symmetric;
     a singular or indefinite A is refused in one line."""
     import pypardiso
 
     pardiso = pypardiso.PyPardisoSolver(mtype=2 if symmetric else 11)
     try:
-        x = pardiso.solve(sp.triu(A, format="csr") if symmetric else sp.csr_matrix(A), b)
+        upper = A.upper if isinstance(A, SymmetricHalf) else sp.triu(A, format="csr") if symmetric else None
+        x = pardiso.solve(upper if symmetric else sp.csr_matrix(A), b)
     except (pypardiso.pardiso_wrapper.PyPardisoError, ValueError) as exc:   # ValueError: an empty row
         raise ProblemError(f"the stiffness matrix is singular or not positive definite (PARDISO: {exc}): the "
                            "constraints do not prevent rigid-body motion, or part of the body is detached") from None
@@ -192,26 +209,34 @@ def _amg(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, symmetric: bool, modes
     return x
 
 
-def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray
-                ) -> tuple[sp.csr_matrix | sp.csc_matrix, np.ndarray]:
+def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray, half: bool = False
+                ) -> tuple[Matrix, np.ndarray]:
     """K's free-free block and the right-hand side F[free] - K[free, fixed] U[fixed] (U zero on the free dofs).
-    For a large K one compiled pass builds the block as CSC (what SuperLU takes): no copies of K's rows and
-    columns on the way, which at 257 x 65 nodes are 160 MB each. The right-hand side's sums differ from
-    scipy's by round-off, so the path is chosen by size alone (a resumed run repeats the first)."""
+    For a large K one compiled pass builds the block as CSC (what SuperLU takes), or with ``half`` its upper
+    triangle as a :class:`SymmetricHalf`: no copies of K's rows and columns on the way, which at 257 x 65 nodes
+    are 160 MB each. The right-hand side's sums differ from scipy's by round-off, so the path is chosen by size
+    alone (a resumed run repeats the first)."""
     if not (rpim_kernels.use_compiled(K.nnz, assembly.COMPILED_MIN_ENTRIES) and isinstance(K, sp.csr_matrix)):
         Kfree = K[free]
         return Kfree[:, free].tocsr(), F[free] - Kfree @ U
     new = np.full(K.shape[0], -1, np.int64)
     new[free] = np.arange(len(free))
     rhs = np.array(F[free], dtype=float)
-    cptr, rows, vals = stiffness_kernels.constrained_csc(K.indptr, K.indices, K.data, new, U, rhs)
     itype = K.indices.dtype
+    if half:
+        if not K.has_sorted_indices:
+            K.sort_indices()
+        rptr, cols, vals = free_block_kernels.constrained_upper(K.indptr, K.indices, K.data, new, U, rhs)
+        upper = sp.csr_matrix((vals, cols, rptr.astype(itype)), shape=(len(free), len(free)), copy=False)
+        upper.has_sorted_indices = True
+        return SymmetricHalf(upper), rhs
+    cptr, rows, vals = free_block_kernels.constrained_csc(K.indptr, K.indices, K.data, new, U, rhs)
     A = sp.csc_matrix((vals, rows, cptr.astype(itype)), shape=(len(free), len(free)), copy=False)
     A.has_sorted_indices = True
     return A, rhs
 
 
-def _banded(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool, symmetric: bool,
+def _banded(A: Matrix, b: np.ndarray, always: bool, symmetric: bool,
             places: np.ndarray | None = None) -> np.ndarray | None:
     """Solve A x = b on A's band (:func:`_band_order`): a ``symmetric`` positive definite A by conjugate gradients
     on the single-precision banded Cholesky factor (:func:`_refined`), else by the double-precision factor directly; a
@@ -232,7 +257,7 @@ def _banded(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, always: bool, symme
     return None if factor is None else _band_solve(factor, b)
 
 
-def _preconditioned(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, order: tuple[np.ndarray, np.ndarray, int],
+def _preconditioned(A: Matrix, b: np.ndarray, order: tuple[np.ndarray, np.ndarray, int],
                     symmetric: bool, precisions: tuple[type, ...]) -> np.ndarray | None:
     """x solving A x = b by :func:`_refined` on the banded Cholesky factor of A (``symmetric``) or of its
     symmetric part, in the first of ``precisions`` whose factor exists and reaches KRYLOV_RTOL; else None."""
@@ -247,7 +272,7 @@ def _preconditioned(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, order: tupl
     return None
 
 
-def _refined(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, M: spla.LinearOperator, symmetric: bool
+def _refined(A: Matrix, b: np.ndarray, M: spla.LinearOperator, symmetric: bool
              ) -> np.ndarray | None:
     """x with |A x - b| <= KRYLOV_RTOL |b| by iterative refinement: conjugate gradients (``symmetric``) or GMRES
     (one cycle) of at most KRYLOV_ITERATIONS to the relative residual KRYLOV_INNER_RTOL, on the true residual,
@@ -271,22 +296,23 @@ def _refined(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, M: spla.LinearOper
     return None
 
 
-def _band_order(A: sp.csr_matrix | sp.csc_matrix, always: bool, places: np.ndarray | None = None
+def _band_order(A: Matrix, always: bool, places: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, int] | None:
     """(permutation, its inverse: the rank of each row, lower half-bandwidth) of the narrower of two orderings of
     A's symmetrised pattern: reverse Cuthill-McKee, and, where ``places`` (n, 2) says where each row's dof sits,
     the rows sorted along the principal axis of those places (:func:`ctmrpim.solvers.banded_lu.principal_axis_order`);
     None when the band is wider than BANDED_MAX_FRACTION of the rows and not ``always``."""
     n = A.shape[0]
-    candidates = [reverse_cuthill_mckee(A, symmetric_mode=True)]
+    candidates = [reverse_cuthill_mckee(A.pattern(), symmetric_mode=True) if isinstance(A, SymmetricHalf)
+                  else reverse_cuthill_mckee(A, symmetric_mode=True)]
     if places is not None:
         candidates.append(principal_axis_order(places))
     best = None
     for perm in candidates:
         rank = np.empty(n, np.int64)
         rank[perm] = np.arange(n)
-        if rpim_kernels.use_compiled(A.nnz, assembly.COMPILED_MIN_ENTRIES):
-            bw = int(stiffness_kernels.lower_bandwidth(A.indptr, A.indices, rank))
+        if _compiled(A):
+            bw = int(free_block_kernels.lower_bandwidth(A.indptr, A.indices, rank))
         else:
             coo = A.tocoo()
             bw = int(np.abs(rank[coo.row] - rank[coo.col]).max()) if A.nnz else 0
@@ -295,7 +321,7 @@ def _band_order(A: sp.csr_matrix | sp.csc_matrix, always: bool, places: np.ndarr
     return None if not always and best[2] > BANDED_MAX_FRACTION * n else best
 
 
-def _band_factor(A: sp.csr_matrix | sp.csc_matrix, order: tuple[np.ndarray, np.ndarray, int], symmetric_part: bool,
+def _band_factor(A: Matrix, order: tuple[np.ndarray, np.ndarray, int], symmetric_part: bool,
                  dtype: type) -> tuple[np.ndarray, np.ndarray] | None:
     """(permutation, lower banded Cholesky factor in ``dtype``) of a symmetric A, or of (A + A^T) / 2 with
     ``symmetric_part``, in the ordering ``order`` (:func:`_band_order`); None when it is not positive definite
@@ -305,8 +331,9 @@ def _band_factor(A: sp.csr_matrix | sp.csc_matrix, order: tuple[np.ndarray, np.n
     perm, rank, bw = order
     n = A.shape[0]
     ab = np.zeros((bw + 1, n), dtype=dtype, order="F")   # LAPACK's layout: factorised in place, not copied
-    if rpim_kernels.use_compiled(A.nnz, assembly.COMPILED_MIN_ENTRIES):
-        stiffness_kernels.fill_lower_band(A.indptr, A.indices, A.data, rank, ab, symmetric_part)
+    if _compiled(A):
+        free_block_kernels.fill_lower_band(A.indptr, A.indices, A.data, rank, ab, symmetric_part,
+                                          isinstance(A, SymmetricHalf))
     else:
         Ap = ((A + A.T) * 0.5 if symmetric_part else A)[perm][:, perm].tocoo()
         lower = Ap.row >= Ap.col
@@ -315,6 +342,12 @@ def _band_factor(A: sp.csr_matrix | sp.csc_matrix, order: tuple[np.ndarray, np.n
         return perm, sla.cholesky_banded(ab, lower=True, overwrite_ab=True, check_finite=False)
     except np.linalg.LinAlgError:
         return None
+
+
+def _compiled(A: Matrix) -> bool:
+    """Whether the band's ordering and fill take the compiled path: by size, as :func:`_free_block` (which makes a
+    SymmetricHalf on that path only)."""
+    return isinstance(A, SymmetricHalf) or rpim_kernels.use_compiled(A.nnz, assembly.COMPILED_MIN_ENTRIES)
 
 
 def _band_solve(factor: tuple[np.ndarray, np.ndarray], b: np.ndarray) -> np.ndarray:

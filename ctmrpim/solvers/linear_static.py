@@ -21,7 +21,7 @@ from ctmrpim.problem.case import Case
 from ctmrpim.problem.model import Problem
 from ctmrpim.reference.error_norms import relative_errors
 from ctmrpim.result import Result, out_of_plane_stress, probe_errors, probe_record
-from ctmrpim.solvers.linear_solver import constrained_system, solve_free
+from ctmrpim.solvers.linear_solver import HALF_SOLVERS, constrained_system, solve_free
 from ctmrpim.timing import Timer
 
 #: Error-norm quadrature: bands and sub-segments at most this many d_c, this many Gauss points each way.
@@ -99,7 +99,8 @@ def solve_ctmrpim(case: Case) -> Result:
     # K of the consistent schemes (their Dirichlet terms) is not symmetric: no Cholesky on K itself
     symmetric = scheme in ("ctm", "cell-gauss")
     n_dofs, k_nnz = K.shape[0], int(K.nnz)
-    system = constrained_system(K, F, fixed, fixed_values)
+    # a symmetric free block is held by its upper triangle where the solver takes that (half the memory)
+    system = constrained_system(K, F, fixed, fixed_values, half=symmetric and method.solver in HALF_SOLVERS)
     del K     # one copy of the stiffness (the free block) while it is factorised
     U = solve_free(*system, method.solver, symmetric, nodes)
     del system

@@ -92,12 +92,14 @@ def test_warm_up_compiles_the_kernels_that_large_cases_take() -> None:
     """The kernels above the compiled thresholds are compiled (or loaded) by the warm-up, before any timed case,
     so that no case's wall time holds their compilation."""
     from ctmrpim.discretisation import rpim_kernels, stiffness_kernels, vci_kernels
+    from ctmrpim.solvers import free_block_kernels
     from studies import sweep
 
     sweep._warm = False
     sweep._warm_up()
     kernels = (rpim_kernels.support_counts, rpim_kernels.rpim_rows, stiffness_kernels.node_pattern_rows,
-               stiffness_kernels.stiffness_rows, stiffness_kernels.mirror_lower, stiffness_kernels.constrained_csc,
-               stiffness_kernels.lower_bandwidth, stiffness_kernels.fill_lower_band, vci_kernels.moments,
+               stiffness_kernels.stiffness_rows, stiffness_kernels.mirror_lower, free_block_kernels.constrained_csc,
+               free_block_kernels.constrained_upper, free_block_kernels.symmetric_matvec,
+               free_block_kernels.lower_bandwidth, free_block_kernels.fill_lower_band, vci_kernels.moments,
                vci_kernels.corrected)
     assert [k.py_func.__name__ for k in kernels if not k.signatures] == []
