@@ -92,9 +92,8 @@ class CorrectedForceRun(ExplicitRun):
     def frame_at(self, x: np.ndarray, free: np.ndarray, points: np.ndarray, w: np.ndarray,
                  loops: list[np.ndarray], triangles: np.ndarray) -> Configuration:
         frame = super().frame_at(x, free, points, w, loops, triangles)
-        test = corrected_operator(frame, self)
         # the step hands over w P (the weights as they are now: points the step inverts get 0)
-        frame.weighted_force = test.force
+        frame.tested = corrected_operator(frame, self)
         return frame
 
 

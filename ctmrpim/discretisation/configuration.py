@@ -66,6 +66,9 @@ class Configuration:
     nodal: NodalIntegration | None = None     # SCNI: the smoothing cells' boundary rule (points = the nodes)
     _G: sp.bsr_matrix | None = field(default=None, repr=False)
     _grad: GradientOperator | None = field(default=None, repr=False)
+    #: the force's test gradients where they are not the trial ones (a measurement's corrected gradients;
+    #: None: the RPIM gradients, the only ones of a solver)
+    tested: GradientOperator | None = field(default=None, repr=False)
 
     @property
     def N(self) -> sp.csr_matrix:
@@ -123,7 +126,7 @@ class Configuration:
         sf = ShapeFunctions(self.sf.N, sp.csr_matrix((data_x, dx.indices, dx.indptr), shape=dx.shape),
                             sp.csr_matrix((data_y, dx.indices, dx.indptr), shape=dx.shape),
                             self.sf.support_sizes, self.sf.dropped)
-        return replace(self, x=x, points=points, w=w, sf=sf, _G=None, _grad=None)
+        return replace(self, x=x, points=points, w=w, sf=sf, _G=None, _grad=None, tested=None)
 
     def moved_points(self, x: np.ndarray) -> np.ndarray:
         """(m, 2) where the points are when the nodes have moved from this configuration's positions to ``x``."""
@@ -138,8 +141,11 @@ class Configuration:
         return self.weighted_force(P * self.w[:, None])
 
     def weighted_force(self, wP: np.ndarray) -> np.ndarray:
-        """(n, 2) sum_p wP_p grad N of first Piola stresses already weighted, wP = w P (m, 4)."""
-        return self.compiled_gradient().force(wP)
+        """(n, 2) sum_p wP_p grad N of first Piola stresses already weighted, wP = w P (m, 4), scattered from the
+        points (the explicit point pass's bits); with ``tested`` gradients, sum_p wP_p grad~N."""
+        if self.tested is not None:
+            return self.tested.force(wP)
+        return self.compiled_gradient().scatter_force(wP)
 
 
 def build(x: np.ndarray, boundary: Boundary, points: np.ndarray, w: np.ndarray, lengths: ScaledMethod, *,

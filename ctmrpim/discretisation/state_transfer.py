@@ -27,7 +27,7 @@ class NodalProjection:
     def __init__(self, N: sp.csr_matrix, weights: np.ndarray) -> None:
         self.N, self.weights = N, weights
         try:
-            self.lu = splu((N.T @ sp.diags(weights) @ N).tocsc())
+            self.lu = splu((N.T @ sp.diags(weights) @ N).tocsc(), permc_spec="MMD_AT_PLUS_A")
         except RuntimeError:
             raise ProblemError("state transfer: the projection's mass matrix is singular (a node has no "
                                "integration point in its support)") from None

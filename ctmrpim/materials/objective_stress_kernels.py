@@ -76,10 +76,10 @@ def largest_strain(F):
 
 
 @njit(cache=True, nogil=True)
-def weighted_first_piola(stress, viscous, with_viscous, F, w, out):
-    """out (m, 4) <- w P, P = det F (sigma + viscous) F^-T (xX, xY, yX, yY) (:func:`first_piola`), the viscous
-    stress added where ``with_viscous``: the explicit step's internal force density in one pass."""
-    for p in range(F.shape[0]):
+def weighted_first_piola_rows(stress, viscous, with_viscous, F, w, out, p0, p1):
+    """out[p] <- w P, P = det F (sigma + viscous) F^-T (xX, xY, yX, yY) (:func:`first_piola`) for p0 <= p < p1, the
+    viscous stress added where ``with_viscous``: the explicit step's internal force density."""
+    for p in range(p0, p1):
         sxx, syy, sxy = stress[p, 0], stress[p, 1], stress[p, 2]
         if with_viscous:
             sxx, syy, sxy = sxx + viscous[p, 0], syy + viscous[p, 1], sxy + viscous[p, 2]
@@ -89,3 +89,9 @@ def weighted_first_piola(stress, viscous, with_viscous, F, w, out):
         out[p, 1] = (sxy * F00 - sxx * F10) * wp
         out[p, 2] = (sxy * F11 - syy * F01) * wp
         out[p, 3] = (syy * F00 - sxy * F10) * wp
+
+
+@njit(cache=True, nogil=True)
+def weighted_first_piola(stress, viscous, with_viscous, F, w, out):
+    """:func:`weighted_first_piola_rows` at every point, in one pass."""
+    weighted_first_piola_rows(stress, viscous, with_viscous, F, w, out, 0, F.shape[0])

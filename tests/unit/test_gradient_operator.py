@@ -46,6 +46,8 @@ def test_products_equal_the_sparse_products(entries: int) -> None:
     ref = np.c_[dx.T @ wP[:, 0] + dy.T @ wP[:, 1], dx.T @ wP[:, 2] + dy.T @ wP[:, 3]]
     assert np.allclose(f, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
     assert np.all(f[0] == 0.0)                                # a node no point supports
+    scattered = op.scatter_force(wP)
+    assert np.allclose(scattered, ref, rtol=0, atol=1e-12 * np.abs(ref).max()) and np.all(scattered[0] == 0.0)
 
 
 def test_the_bits_do_not_depend_on_the_threads(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -57,9 +59,11 @@ def test_the_bits_do_not_depend_on_the_threads(monkeypatch: pytest.MonkeyPatch) 
         monkeypatch.setattr(thread_blocks, "THREADS", threads)
         op = go.GradientOperator(dx, dy)
         assert len(op._row_blocks) == threads
-        results.append((op.gradient(d), op.force(wP)))
-    for F, f in results[1:]:
+        assert len(op.scatter_blocks) == go.SCATTER_BLOCKS        # fixed, whatever the threads
+        results.append((op.gradient(d), op.force(wP), op.scatter_force(wP)))
+    for F, f, g in results[1:]:
         assert np.array_equal(F, results[0][0]) and np.array_equal(f, results[0][1])
+        assert np.array_equal(g, results[0][2])
 
 
 def test_the_force_is_a_scatter_in_point_order() -> None:
@@ -67,9 +71,11 @@ def test_the_force_is_a_scatter_in_point_order() -> None:
     fused multiply-adds where the machine has them, the gather may differ from this Python sum in the last bit)."""
     dx, dy = _gradients(300, 60, 12, seed=4)
     wP = np.random.default_rng(5).normal(size=(300, 4))
-    f = go.GradientOperator(dx, dy).force(wP)
+    op = go.GradientOperator(dx, dy)
     ref = _scatter(dx, dy, wP)
-    assert np.allclose(f, ref, rtol=0, atol=4 * np.finfo(float).eps * np.abs(ref).max())
+    assert np.allclose(op.force(wP), ref, rtol=0, atol=4 * np.finfo(float).eps * np.abs(ref).max())
+    # the scattered force is that serial scatter (one block here), without fused multiply-adds: to the bit
+    assert len(op.scatter_blocks) == 1 and np.array_equal(op.scatter_force(wP), ref)
 
 
 def test_a_forked_process_gets_its_own_pool() -> None:

@@ -18,22 +18,59 @@ A ``gate`` wall holds the column during the initial gravity stage only and is re
 """
 from __future__ import annotations
 
-import numpy as np
+import math
+from functools import lru_cache
 
-from ctmrpim.problem.model import Wall
+import numpy as np
+from numba import njit
+
+from ctmrpim.problem.model import NO_SLIP, Wall
+
+#: The friction column of :func:`wall_table` for a no-slip wall.
+TABLE_NO_SLIP = -1.0
+
+
+@lru_cache(maxsize=16)
+def wall_table(walls: tuple[Wall, ...]) -> np.ndarray:
+    """(k, 5) the walls as the compiled contact reads them: point x, y, unit normal x, y, friction coefficient
+    (:data:`TABLE_NO_SLIP` for no slip); made once per set of walls (read-only: the explicit step asks every step)."""
+    table = np.array([[*w.point, *w.normal, TABLE_NO_SLIP if w.friction == NO_SLIP else float(w.friction)]
+                      for w in walls], float).reshape(-1, 5)
+    table.flags.writeable = False
+    return table
+
+
+@njit(cache=True, nogil=True)
+def contact(table, x0, x1, v0, v1, dt):
+    """The half-step velocity (v0, v1) of a node at (x0, x1) after contact with the walls of ``table``
+    (:func:`wall_table`), applied in turn."""
+    for k in range(table.shape[0]):
+        n0, n1, mu = table[k, 2], table[k, 3], table[k, 4]
+        g = (x0 - table[k, 0]) * n0 + (x1 - table[k, 1]) * n1
+        vn = v0 * n0 + v1 * n1
+        if not g + dt * vn < 0.0:
+            continue
+        vn_new = -g / dt
+        dvn = vn_new - vn                          # > 0: the normal impulse per unit mass
+        t0, t1 = v0 - vn * n0, v1 - vn * n1
+        if mu == TABLE_NO_SLIP:
+            t0 = t1 = 0.0
+        elif mu != 0.0:                            # Coulomb: |dv_t| <= mu |dv_n|, stick where that is enough
+            size = math.hypot(t0, t1)
+            keep = max(size - mu * abs(dvn), 0.0) / (size if size > 0.0 else 1.0)
+            t0, t1 = t0 * keep, t1 * keep
+        v0, v1 = t0 + vn_new * n0, t1 + vn_new * n1
+    return v0, v1
+
+
+@njit(cache=True, nogil=True)
+def _contact_rows(table, x, v, dt, out):
+    for j in range(x.shape[0]):
+        out[j, 0], out[j, 1] = contact(table, x[j, 0], x[j, 1], v[j, 0], v[j, 1], dt)
 
 
 def enforce_walls(walls: list[Wall], x: np.ndarray, v: np.ndarray, dt: float) -> np.ndarray:
     """The half-step velocities (n, 2) after contact with ``walls`` (applied in turn), for nodes at ``x``."""
-    v = v.copy()
-    for wall in walls:
-        n = np.asarray(wall.normal)
-        g = wall.gap(x)
-        vn = v @ n
-        hit = g + dt * vn < 0.0
-        if not hit.any():
-            continue
-        vn_new = -g[hit] / dt
-        dvn = vn_new - vn[hit]                       # > 0: the normal impulse per unit mass
-        v[hit] = wall.slip(v[hit] - vn[hit, None] * n, dvn) + vn_new[:, None] * n
-    return v
+    out = np.empty((len(x), 2))
+    _contact_rows(wall_table(tuple(walls)), np.ascontiguousarray(x, float), np.ascontiguousarray(v, float), float(dt), out)
+    return out

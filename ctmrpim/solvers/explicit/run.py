@@ -10,6 +10,8 @@ run; each of its parts is a module of this package:
 - :mod:`~ctmrpim.solvers.explicit.frame`: the configuration the points are built on (boundary, CTM points,
   RPIM), F_int written on it, the points dropped at a thinning front;
 - :mod:`~ctmrpim.solvers.explicit.step`: one central-difference step (Eqs. 9-11), the viscosity;
+- :mod:`~ctmrpim.solvers.explicit.nodal_update`, :mod:`~ctmrpim.solvers.explicit.point_pass`: the step's compiled
+  passes over the nodes (update, walls, works) and over the points (gradient, stress update, internal force);
 - :mod:`~ctmrpim.solvers.explicit.contact`: the rigid walls;
 - :mod:`~ctmrpim.solvers.explicit.rebuild`: the two-level rebuilds and the state transfer;
 - :mod:`~ctmrpim.solvers.explicit.time_step`: the stable time step;
@@ -198,6 +200,7 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
         """End of the gravity stage: at rest, t = 0, gates removed, accounts opened."""
         self.v[:] = 0.0
         self.viscous[:] = 0.0            # at rest: no strain rate
+        self.force_of_F = None           # the force of the last step had the viscous stress in it
         self.stage, self.t, self.step = "dynamic", 0.0, 0
         self.energy = Energy(elastic0=self.elastic_energy())
         self.record()

@@ -38,6 +38,8 @@ class RunState:
     viscous: np.ndarray             # (m, 4) viscous stress of the last step
     F: np.ndarray                   # (m, 4) deformation gradient relative to the frame
     strain_of_F: tuple[np.ndarray, float] | None = None   # (F, its largest stretch strain), as the step measured it
+    force_of_F: tuple[np.ndarray, Configuration, np.ndarray] | None = None   # (F, frame, F_int there), as the step
+                                    # scattered it for the stress it left (to be cleared where that stress changes)
     laid: np.ndarray                # (m, 4) deformation gradient since the points were laid, up to the frame
     mode: np.ndarray                # (n, 2) the power iteration's vector (time step)
     dt: float                       # the time step

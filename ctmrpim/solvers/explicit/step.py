@@ -20,8 +20,9 @@ surface flattened well below the experiment's; study ``column_collapse_viscosity
 experiment was first compared with, carry an artificial viscosity, and a real granular flow's friction
 grows with its shear rate (the mu(I) rheology), which a rate-independent model lacks. The value is a
 setting, fitted for the benchmark (study ``column_collapse_viscosity``). The per-point work is in
-:mod:`ctmrpim.materials.mohr_coulomb_kernel` (compiled); the internal force's products in
-:mod:`ctmrpim.discretisation.gradient_operator`.
+:mod:`ctmrpim.materials.mohr_coulomb_kernel` and the pass over the points, which also scatters the next step's
+internal force, in :mod:`ctmrpim.solvers.explicit.point_pass` (compiled); the nodal update, walls and works in
+:mod:`ctmrpim.solvers.explicit.nodal_update` (compiled).
 
 **Inverted points**: a point which one step turns inside out gets weight 0, like the points dropped by
 the frame (it integrates nothing; counted in ``summary.json``). More than INVERTED_LIMIT of the points
@@ -36,10 +37,11 @@ from ctmrpim.materials.mohr_coulomb_kernel import PointUpdate
 from ctmrpim.materials.objective_stress import det_c, hughes_winget_c, relative_c, rotate_c
 from ctmrpim.materials.objective_stress_kernels import weighted_first_piola
 from ctmrpim.problem.model import Wall
-from ctmrpim.solvers.explicit.contact import enforce_walls
+from ctmrpim.solvers.explicit.contact import wall_table
 from ctmrpim.solvers.explicit.energy import contract
 from ctmrpim.solvers.explicit.errors import Diverged
 from ctmrpim.solvers.explicit.frame import IDENTITY
+from ctmrpim.solvers.explicit.nodal_update import nodal_update
 from ctmrpim.solvers.explicit.point_pass import point_pass
 
 #: More than this share of the integrating points inverted by one step: the step is unstable.
@@ -54,36 +56,36 @@ class CentralDifference:
     def advance(self, walls: list[Wall], damping: float) -> None:
         """One central-difference step from (x_n, v_{n-1/2}, stress_n) to (x_{n+1}, v_{n+1/2}, stress_{n+1})."""
         fr, dt, F = self.frame, self.dt, self.F
-        wP = np.empty((len(fr.w), 4))
-        weighted_first_piola(self.stress, self.viscous, bool(self.settings.viscosity), F, fr.w, wP)
-        f_int = fr.weighted_force(wP)
-        f = self.weight - f_int
-        f_damp = -damping * np.abs(f) * np.sign(self.v) if damping else 0.0
-        dv = dt * (f + f_damp) / self.mass[:, None]
-        v = np.where(self.movable, self.v + dv, 0.0)
-        v = enforce_walls(walls, self.x, v, dt)
-        if not np.isfinite(v).all():
-            i = int(np.flatnonzero(~np.isfinite(v).all(axis=1))[0])
-            raise Diverged(f"non-finite velocity at node #{i} ({self.x[i, 0]:.5g}, {self.x[i, 1]:.5g}) at step "
+        viscosity = bool(self.settings.viscosity)
+        known = self.force_of_F
+        if known is not None and known[0] is F and known[1] is fr:
+            f_int = known[2]            # the last step's point pass scattered it on its way
+        else:
+            wP = np.empty((len(fr.w), 4))
+            weighted_first_piola(self.stress, self.viscous, viscosity, F, fr.w, wP)
+            f_int = fr.weighted_force(wP)
+        v, x, f = np.empty_like(self.v), np.empty_like(self.x), np.empty_like(self.x)
+        works = np.zeros(4 if self.stage == "dynamic" else 0)
+        bad = nodal_update(f_int, self.weight, self.mass, self.movable, self.v, self.x, dt, float(damping),
+                           wall_table(tuple(walls)), works, v, x, f)
+        if bad >= 0:
+            raise Diverged(f"non-finite velocity at node #{bad} ({self.x[bad, 0]:.5g}, {self.x[bad, 1]:.5g}) at step "
                            f"{self.step}, t = {self.t:.6g} s")
-        dx = dt * v
         if self.stage == "gravity":
             self.stage_residual = out_of_balance(f, walls, self.movable, self.x, self.weight, self.d_c)
         else:
-            mid = 0.5 * dt * (v + self.v)       # dt (v_{n+1/2} + v_{n-1/2}) / 2: exact for any dt sequence
             e = self.energy
-            e.gravity += float(np.sum(self.weight * mid))
-            e.internal += float(np.sum(f_int * mid))
-            if damping:
-                e.damping += float(np.sum(f_damp * mid))
-            e.walls += float(np.sum(self.mass[:, None] * (v - self.v - dv) * 0.5 * (v + self.v)))
+            e.gravity += float(works[0])
+            e.internal += float(works[1])
+            e.damping += float(works[2])
+            e.walls += float(works[3])
         self.timer.lap("forces")
-        x = self.x + dx
         if self.material.tension is None:
             upd = point_pass(fr, x - fr.x, F, self.stress, self.plastic, self.viscous, self.material,
-                             self.settings.viscosity / dt)
+                             self.settings.viscosity / dt, viscosity, force=fr.tested is None)
             self._drop_inverted(upd.inverted, x, F)
             F_new, self.strain_of_F = upd.F, (upd.F, upd.largest_strain)
+            self.force_of_F = None if upd.force is None else (upd.F, fr, upd.force)
         else:
             F_new = fr.gradient(x - fr.x)
             f_inc = relative_c(F_new, F)
@@ -92,6 +94,7 @@ class CentralDifference:
             if dead.any():
                 f_inc[dead], F_new[dead] = IDENTITY, IDENTITY
             upd = point_update_numpy(self.material, f_inc, self.stress, self.plastic, dead, fr.w * det_c(F_new))
+            self.force_of_F = None
         if self.stage == "dynamic":
             self.energy.plastic += upd.dissipation
             self.energy.viscous += upd.viscous_work
