@@ -53,12 +53,11 @@ def _write(quick: bool, out_dir: Path, tables: dict, side: SideRuns, progress: P
     root = out_dir if quick else out_dir.parent
     checks = all_checks(tables, out_dir if quick else None)   # a full run's collapse checks are its own already
     claim_rows = claims_table(tables)
-    buf = io.StringIO()
-    w = buf.write
-    summary.write_title(w, quick, checks, claim_rows)
-    summary.write_claims(w, claim_rows, tables)
-    summary.write_accuracy_checks(w, checks)
-    summary.write_provenance(w, root)
+    head, body = io.StringIO(), io.StringIO()
+    summary.write_title(head.write, quick, checks, claim_rows)
+    summary.write_claims(head.write, claim_rows, tables)
+    summary.write_accuracy_checks(head.write, checks)
+    w = body.write          # the provenance goes between the two, once this run's own outputs are stamped
     side.result("models", progress)
     models.write_models(w)
     linear.write_node_density(w, tables["node_density"])
@@ -93,6 +92,8 @@ def _write(quick: bool, out_dir: Path, tables: dict, side: SideRuns, progress: P
     if not quick:   # the full report's own figures and tables carry their provenance like the studies' results
         for name in side_runs.RUNS:
             side_runs.stamp_outputs(name, out_dir)
-    atomic_write_text(out_dir / "REPORT.md", buf.getvalue())
+    provenance = io.StringIO()
+    summary.write_provenance(provenance.write, root)
+    atomic_write_text(out_dir / "REPORT.md", head.getvalue() + provenance.getvalue() + body.getvalue())
     progress("\n" + console_summary(checks, claim_rows))
 
