@@ -1,5 +1,5 @@
 """Wall time of the granular column collapse (the 1071-node collapse to rest in at most 60 s on this 2-core
-machine, the 2016-node one in at most 240 s: ``--set parameters.h=...`` for the finer cloud):
+machine, the 2016-node one in at most 240 s: ``--set "nodes.grid=[63, 32]"`` for that cloud):
 
     python performance/bench_column_collapse.py [--set SECTION.KEY=VALUE ...] [--out DIR]
 

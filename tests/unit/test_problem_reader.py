@@ -93,6 +93,7 @@ def test_overrides() -> None:
     ("constraint.where=1", "can set keys of"),
     ("foo.bar=1", "can set keys of"),
     ("nodes.grid=[17,5", "not valid TOML"),
+    ("parameters.h=0.5", r"no parameter 'h' \(its parameters: P, E, nu, L, W, I\)"),   # would define one nothing uses
 ])
 def test_bad_overrides(item: str, match: str) -> None:
     with pytest.raises(ProblemError, match=match) as info:

@@ -28,6 +28,9 @@ def apply_overrides(raw: dict, overrides: list[str]) -> dict:
                 raise ProblemError(f"--set {item!r}: the value is not valid TOML ({exc})") from None
             parsed = value.strip()
         table = raw.setdefault(section, {})
+        if section == "parameters" and key not in table:     # it would define a parameter that nothing uses
+            known = ", ".join(table) or "none"
+            raise ProblemError(f"--set {item!r}: the problem has no parameter {key!r} (its parameters: {known})")
         if section == "nodes" and key in PLACEMENTS:  # grid, spacing and file exclude each other: the new one replaces
             for other in PLACEMENTS:
                 table.pop(other, None)
