@@ -45,7 +45,7 @@ from ctmrpim.materials.objective_stress_kernels import stretch_strain, weighted_
 
 #: points a block goes through the pass's loops in at a time: their rows (about 43 entries each on the column's
 #: clouds, 20 bytes an entry: about 110 kB) stay in the second-level cache from the gradient to the force's scatter
-#: (measured on the 1071-node column's points, two threads, best of 300: 8 points 1.00 ms, 32 0.93, 128 0.86,
+#: (measured on the 1071-node column's points, two threads, best of 300: 8 points 1.0 ms, 32 0.93, 128 0.86,
 #: 512 0.87, the whole block at once 0.90)
 CHUNK = 128
 
