@@ -43,7 +43,8 @@ def wall_table(walls: tuple[Wall, ...]) -> np.ndarray:
 @njit(cache=True, nogil=True)
 def contact(table, x0, x1, v0, v1, dt):
     """The half-step velocity (v0, v1) of a node at (x0, x1) after contact with the walls of ``table``
-    (:func:`wall_table`), applied in turn."""
+    (:func:`wall_table`), applied in turn; the tangential rule is :meth:`ctmrpim.problem.model.Wall.slip`'s, compiled
+    for one node (the gravity stage's out-of-balance force applies the numpy form to forces)."""
     for k in range(table.shape[0]):
         n0, n1, mu = table[k, 2], table[k, 3], table[k, 4]
         g = (x0 - table[k, 0]) * n0 + (x1 - table[k, 1]) * n1
@@ -61,16 +62,3 @@ def contact(table, x0, x1, v0, v1, dt):
             t0, t1 = t0 * keep, t1 * keep
         v0, v1 = t0 + vn_new * n0, t1 + vn_new * n1
     return v0, v1
-
-
-@njit(cache=True, nogil=True)
-def _contact_rows(table, x, v, dt, out):
-    for j in range(x.shape[0]):
-        out[j, 0], out[j, 1] = contact(table, x[j, 0], x[j, 1], v[j, 0], v[j, 1], dt)
-
-
-def enforce_walls(walls: list[Wall], x: np.ndarray, v: np.ndarray, dt: float) -> np.ndarray:
-    """The half-step velocities (n, 2) after contact with ``walls`` (applied in turn), for nodes at ``x``."""
-    out = np.empty((len(x), 2))
-    _contact_rows(wall_table(tuple(walls)), np.ascontiguousarray(x, float), np.ascontiguousarray(v, float), float(dt), out)
-    return out
