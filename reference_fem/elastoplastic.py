@@ -24,7 +24,8 @@ from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result, probe_record
-from ctmrpim.solvers.plastic_system import PlasticOutput, PlasticSystem, run_elastoplastic
+from ctmrpim.solvers.plastic_analysis import PlasticOutput, run_elastoplastic
+from ctmrpim.solvers.plastic_system import PlasticSystem
 from ctmrpim.timing import Timer
 from reference_fem.boundary_conditions import (
     FACET_ORDER,
@@ -57,7 +58,7 @@ def gradient_operator(basis: Basis) -> sp.csr_matrix:
 
 def solve_fem_elastoplastic(case: Case, element: str = "p2",
                             progress: Callable[[Any], None] = lambda level: None) -> Result:
-    """:func:`ctmrpim.solvers.plastic_system.run_elastoplastic` with the finite element ``element``."""
+    """:func:`ctmrpim.solvers.plastic_analysis.run_elastoplastic` with the finite element ``element``."""
     problem = case.problem
     if not isinstance(problem.material, MohrCoulomb):
         raise ProblemError("the elastoplastic FEM reference needs model = \"mohr-coulomb\"", key="material.model")

@@ -65,6 +65,20 @@ class BandedFactors:
         return x
 
 
+class BandedCholeskyFactors:
+    """dpbtrf's factors (upper) of a symmetric positive definite free block, in the band's order."""
+
+    def __init__(self, cb: np.ndarray, perm: np.ndarray) -> None:
+        self.cb, self.perm = cb, perm
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """A^-1 b (n,)."""
+        y, info = lapack.dpbtrs(self.cb, b[self.perm])
+        x = np.empty_like(y)
+        x[self.perm] = y
+        return x
+
+
 class BandedLU:
     """The band of the free block (rows and columns ``free``) of matrices on ``pattern``'s CSR pattern; ``nodes``
     (n, 2): where the dofs 2i, 2i + 1 sit, for the ordering along the principal axis (None: RCM alone)."""
@@ -92,6 +106,9 @@ class BandedLU:
         self.perm, self.kl, self.ku, pr, pc = best
         self.rows = 2 * self.kl + self.ku + 1          # dgbtrf's storage: kl more rows for the row interchanges
         self.place = pc * self.rows + (self.kl + self.ku + pr - pc)   # in the (n, rows) C array = F-ordered band
+        upper = pr <= pc                               # dpbtrf's storage of a symmetric band: its upper half
+        self.upper_take = self.take[upper]
+        self.upper_place = pc[upper] * (self.ku + 1) + (self.ku + pr[upper] - pc[upper])
         self.per_row = len(r) / max(n, 1)
 
     @property
@@ -116,4 +133,20 @@ class BandedLU:
         if info < 0:
             raise ValueError(f"dgbtrf: illegal argument {-info}")
         return BandedFactors(lub, piv, self.kl, self.ku, self.perm)
+
+    def cholesky(self, K: sp.csr_matrix) -> BandedCholeskyFactors:
+        """The Cholesky factors (dpbtrf) of K's free block, K symmetric positive definite on a symmetric pattern
+        (its upper half is read): half the band of the LU, whose row interchanges widen U to kl + ku, and a
+        substitution about twice as fast (the 1928-node slope's elastic stiffness, 3613 free dofs, half-width
+        387: 0.79 ms against 1.59 ms for dgbtrs and for SuperLU's MMD_AT_PLUS_A factors, one thread).
+        RuntimeError where K is not positive definite."""
+        band = np.zeros((self.n, self.ku + 1))
+        band.ravel()[self.upper_place] = K.data[self.upper_take]
+        with one_blas_thread():
+            cb, info = lapack.dpbtrf(band.T, lower=0, overwrite_ab=1)
+        if info > 0:
+            raise RuntimeError("the matrix is not positive definite")
+        if info < 0:
+            raise ValueError(f"dpbtrf: illegal argument {-info}")
+        return BandedCholeskyFactors(cb, self.perm)
 

@@ -29,6 +29,7 @@ from ctmrpim import progress
 from ctmrpim.errors import ConvergenceError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.problem.settings import Relaxation
+from ctmrpim.solvers.plastic_system import PlasticSystem
 
 #: Fictitious mass per node = SAFETY x the largest absolute row sum of its dofs' elastic stiffness rows.
 SAFETY = 1.0
@@ -57,15 +58,15 @@ def max_displacement(U: np.ndarray) -> float:
     return float(np.linalg.norm(U.reshape(-1, 2), axis=1).max())
 
 
-def relaxation_mass(system) -> np.ndarray:
+def relaxation_mass(system: PlasticSystem) -> np.ndarray:
     """(2n,) per dof: the fictitious nodal mass (equal for a node's two dofs) of ``system``, a
-    :class:`~ctmrpim.solvers.plastic_system.PlasticSystem` (not imported: that module imports this one)."""
+    :class:`~ctmrpim.solvers.plastic_system.PlasticSystem`."""
     K = abs(system.elastic_stiffness())
     rows = np.asarray(K.sum(axis=1)).ravel()          # dofs are interleaved (x, y) per node
     return SAFETY * np.repeat(rows.reshape(-1, 2).max(axis=1), 2)
 
 
-def relax(system, material: MohrCoulomb, load_factor: float, settings: Relaxation,
+def relax(system: PlasticSystem, material: MohrCoulomb, load_factor: float, settings: Relaxation,
           fixed_values: np.ndarray | None = None) -> RelaxationPath:
     """Relax the ``system`` (a :class:`~ctmrpim.solvers.plastic_system.PlasticSystem`) from its committed state
     under the loads at ``load_factor`` with ``material``; the state is committed at every step. Prescribed

@@ -22,7 +22,8 @@ from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import MohrCoulomb
 from ctmrpim.problem.case import Case
 from ctmrpim.result import Result, probe_record
-from ctmrpim.solvers.plastic_system import PlasticOutput, PlasticSystem, run_elastoplastic
+from ctmrpim.solvers.plastic_analysis import PlasticOutput, run_elastoplastic
+from ctmrpim.solvers.plastic_system import PlasticSystem
 from ctmrpim.timing import Timer
 
 

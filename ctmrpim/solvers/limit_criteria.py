@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from ctmrpim.solvers.load_stepping import LoadPath
+from ctmrpim.solvers.plastic_system import PlasticSystem
 
 
 @dataclass
@@ -34,9 +35,8 @@ class SettlementCriterion:
     U0: np.ndarray                 # the state the loads start from (the settlement counts from it)
 
     @classmethod
-    def build(cls, system: Any, fraction: float) -> SettlementCriterion:
-        """The criterion of ``system``'s loads (a :class:`~ctmrpim.solvers.plastic_system.PlasticSystem`; not
-        imported: that module imports this one) (their increment from load factor 0 to 1)."""
+    def build(cls, system: PlasticSystem, fraction: float) -> SettlementCriterion:
+        """The criterion of ``system``'s loads (their increment from load factor 0 to 1)."""
         F = system.external_force(1.0) - system.external_force(0.0)
         F[system.fixed] = 0.0
         direction = F / max(np.abs(F).sum(), 1e-300)

@@ -120,6 +120,7 @@ class LoadPath:
     newton_iterations: int = 0
     failed_at: float | None = None   # with ``stop_on_failure``: the load factor that did not converge
     failed_trial: np.ndarray | None = None   # and the last iterate there (the first attempt's if the re-check failed)
+    stopped: str | None = None       # with ``stop``: why the path ended at its last converged increment
 
 
 @dataclass
@@ -144,8 +145,8 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
                judge: Callable[[float, np.ndarray, float, np.ndarray], tuple[str | None, dict]] | None = None,
                recheck: bool = False, snapshot: Callable[[], Any] | None = None,
                restore: Callable[[Any], None] | None = None,
-               recheck_assemble: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, sp.spmatrix]] | None = None
-               ) -> LoadPath:
+               recheck_assemble: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, sp.spmatrix]] | None = None,
+               stop: Callable[[float, np.ndarray], str | None] | None = None) -> LoadPath:
     """Apply the load in increments of the load factor from 0 up to 1 (cut-backs, the response criterion
     ``judge`` with ``snapshot`` and ``restore``, the ``recheck`` and its ``recheck_assemble``: the module doc).
 
@@ -154,7 +155,9 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
     U)`` the extra history entries of a converged increment (it may record the state). The path starts from ``U0``
     (default zero), the prescribed displacements going linearly from their values there to ``fixed_values``. With
     no cut-back left the solve raises a ConvergenceError with the history so far, or with ``stop_on_failure``
-    returns the path so far with ``failed_at`` set. ``anderson = m > 0``: :class:`Anderson` mixing of depth m."""
+    returns the path so far with ``failed_at`` set. ``anderson = m > 0``: :class:`Anderson` mixing of depth m.
+    ``stop(factor, U)``, where given, reads every converged increment before the last once it is carried and returns why the path
+    ends there (the path is returned with ``stopped`` set, its last increment carried) or None."""
     path = LoadPath(U=np.zeros(n_dofs) if U0 is None else U0.copy())
     start_values = path.U[fixed].copy()
     walk = _Walk(factor=0.0, dfactor=1.0 / loading.steps, max_step=1.0 / loading.steps)
@@ -218,6 +221,10 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
         path.history.append({"load_factor": walk.factor, "converged": True, "iterations": it,
                              **({"note": note} if note else {}), **judged, **on_converged(walk.factor, path.U)})
         walk.converged += 1
+        if stop is not None and walk.factor < 1.0 - 1e-12:
+            path.stopped = stop(walk.factor, path.U)
+            if path.stopped is not None:
+                break
     report.status("")
     return path
 

@@ -40,13 +40,10 @@ import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
 
 from ctmrpim.errors import ProblemError
-from ctmrpim.materials.mohr_coulomb import ELASTIC, MohrCoulomb, equivalent_plastic_strain, plastic_strain_increment
+from ctmrpim.materials.mohr_coulomb import ELASTIC, MohrCoulomb, plastic_strain_increment
 from ctmrpim.materials.mohr_coulomb_kernel import small_strain_update
-from ctmrpim.problem.case import Case
 from ctmrpim.problem.settings import Loading
-from ctmrpim.result import Result
 from ctmrpim.solvers.banded_lu import BandedLU
-from ctmrpim.solvers.limit_criteria import SettlementCriterion, limit_load
 from ctmrpim.solvers.load_stepping import LoadPath, step_loads
 from ctmrpim.solvers.weak_form import internal_force, tangent
 from ctmrpim.timing import Timer
@@ -261,13 +258,11 @@ class PlasticSystem:
 
         Where the elastic stiffness's band is narrow against its rows (meshfree supports), a Newton tangent on
         its pattern is factorised by the banded LU instead (:mod:`ctmrpim.solvers.banded_lu`), whose zero pivot on
-        such a row is its RuntimeError. Not the elastic stiffness (``banded`` False): its factors serve every
-        iteration of the elastic-stiffness iteration, and the band's substitution is about twice SuperLU's work
-        (8.4 against 4.5 MFlop on the 1928-node slope)."""
-        if banded and self._band is None:
-            band = BandedLU(self.elastic_stiffness(), self.free, self.nodes)
-            self._band = band if band.worthwhile else False
-        if banded and self._band and self._band.fits(K):
+        such a row is its RuntimeError. Not a non-symmetric elastic stiffness (``banded`` False): its factors serve
+        every iteration of the elastic-stiffness iteration, and the LU band's substitution is about twice SuperLU's
+        work (8.4 against 4.5 MFlop on the 1928-node slope); a symmetric one takes the band's Cholesky
+        (:meth:`_elastic_factors`)."""
+        if banded and self._banded() and self._band.fits(K):
             return self._band.factorise(K)
         Kff = K[self.free][:, self.free].tocsc()
         magnitude = abs(Kff)
@@ -304,14 +299,33 @@ class PlasticSystem:
         return x
 
     def _elastic_factors(self):
-        """The factors of the constrained elastic stiffness, computed once (a singular one is a model error)."""
+        """The factors of the constrained elastic stiffness, computed once (a singular one is a model error): the
+        banded Cholesky where the weak form is symmetric (Bubnov-Galerkin, no consistency term) and the band is
+        narrow (:meth:`~ctmrpim.solvers.banded_lu.BandedLU.cholesky`: its substitution, which every iteration of the
+        elastic-stiffness iteration does, is half SuperLU's), else SuperLU's LU."""
         if self._lu_elastic is None:
-            try:
-                self._lu_elastic = self._factorise(self.elastic_stiffness(), banded=False)
-            except RuntimeError as exc:
-                raise self._unconstrained(exc) from None
+            K = self.elastic_stiffness()
+            band = self._banded()
+            if band and self.test is None and not self.consistent:
+                try:
+                    self._lu_elastic = band.cholesky(K)
+                except RuntimeError as exc:
+                    raise self._unconstrained(exc) from None
+            else:
+                try:
+                    self._lu_elastic = self._factorise(K, banded=False)
+                except RuntimeError as exc:
+                    raise self._unconstrained(exc) from None
             self.factorisations += 1
         return self._lu_elastic
+
+    def _banded(self) -> BandedLU | bool:
+        """The band of the elastic stiffness's pattern, laid out on first use, or False where it is not narrow
+        against the rows (:attr:`~ctmrpim.solvers.banded_lu.BandedLU.worthwhile`)."""
+        if self._band is None:
+            band = BandedLU(self.elastic_stiffness(), self.free, self.nodes)
+            self._band = band if band.worthwhile else False
+        return self._band
 
     def iteration_counts(self) -> dict[str, Any]:
         """Tangents built, factorisations and the seconds spent in each phase of the iterations."""
@@ -323,10 +337,10 @@ class PlasticSystem:
             load_at: Callable[[float], float], on_converged: Callable[[float, np.ndarray], dict[str, Any]],
             fixed_values: np.ndarray | None = None, stop_on_failure: bool = False,
             judge: Callable[[float, np.ndarray, float, np.ndarray], tuple[str | None, dict]] | None = None,
-            recheck: bool = False) -> LoadPath:
+            recheck: bool = False, stop: Callable[[float, np.ndarray], str | None] | None = None) -> LoadPath:
         """Step a path parameter t from 0 to 1 from the committed state: the material is
         ``material_at(t)`` and the loads are at ``load_at(t)`` times their full value (a load ramp,
-        or a strength-reduction stage at constant load); ``judge`` and ``recheck`` as in
+        or a strength-reduction stage at constant load); ``judge``, ``recheck`` and ``stop`` as in
         :func:`~ctmrpim.solvers.load_stepping.step_loads`."""
         if self.tangent != "elastic":
             self._K = None
@@ -349,102 +363,9 @@ class PlasticSystem:
                               self.fixed_values if fixed_values is None else fixed_values, assemble, self.solve,
                               converged, U0=self.U, stop_on_failure=stop_on_failure, anderson=ANDERSON,
                               judge=judge, recheck=recheck, snapshot=self.snapshot, restore=self.restore,
-                              recheck_assemble=assemble_consistent if self.tangent == "elastic" else None)
+                              recheck_assemble=assemble_consistent if self.tangent == "elastic" else None,
+                              stop=stop)
 
     def elastic_response(self, F: np.ndarray) -> np.ndarray:
         """U (2n,) of the elastic stiffness under the forces F (2n,), zero at the fixed dofs."""
         return self._solve_free(self._elastic_factors(), F)
-
-
-@dataclass
-class PlasticOutput:
-    """How a discretisation reports a :class:`PlasticSystem`'s state (CTM-RPIM nodes or mesh vertices)."""
-
-    method: str
-    points: np.ndarray                                          # (n, 2) output points
-    cells: list
-    displacement: Callable[[np.ndarray], np.ndarray]            # U -> (n, 2) at the points
-    nodal: Callable[[np.ndarray], np.ndarray]                   # (m, k) at the integration points -> (n, k)
-    average: Callable[[np.ndarray], np.ndarray]                 # the same, a non-negative weighted mean of them
-    probe_values: Callable[[np.ndarray, np.ndarray], dict]      # (U, stress (m, 3)) -> {name: probe record}
-    peak_traction: float                                        # largest traction magnitude at full load
-    counts: dict[str, Any]
-    parameters: dict[str, Any]
-
-    def plastic_field(self, plastic_strain: np.ndarray) -> dict[str, np.ndarray]:
-        """Point data ``plastic_strain``: the equivalent plastic strain of (m, 4) point values, at the points,
-        by ``average``: a projection that can overshoot would show negative plastic strain beside a shear band."""
-        return {"plastic_strain": self.average(equivalent_plastic_strain(plastic_strain)[:, None])[:, 0]}
-
-    def nodal_stress(self, stress: np.ndarray) -> dict[str, np.ndarray]:
-        """``stress`` (n, 3: sxx, syy, sxy) and ``stress_zz`` (n,) at the points of the (m, 4: xx, yy, xy, zz)
-        stresses at the integration points."""
-        nodal = self.nodal(stress)
-        return {"stress": nodal[:, :3], "stress_zz": nodal[:, 3]}
-
-
-def run_elastoplastic(case: Case, system: PlasticSystem, out: PlasticOutput, timer: Timer,
-                      progress: Callable[[Any], None] = lambda level: None) -> Result:
-    """Load-stepped solve of a quasi-static Mohr-Coulomb Case (gravity ramped with the load factor; with
-    ``loading.until_failure`` up to the limit load), or its strength reduction (``progress`` gets each
-    level), on any discretisation."""
-    material = case.problem.material
-    series: list[dict] = []
-
-    def on_converged(factor: float, U: np.ndarray) -> dict:
-        series.append({"load_factor": factor, "u": out.displacement(U), **out.nodal_stress(system.stress),
-                       "fields": out.plastic_field(system.plastic_strain)})
-        record = {"plastic_points": int((system.region != ELASTIC).sum())}
-        for name, rec in out.probe_values(U, None).items():
-            record[name] = {k: rec[k] for k in ("x", "y", "ux", "uy")}
-        return record
-
-    if case.problem.analysis == "strength-reduction":
-        from ctmrpim.solvers.strength_reduction import solve_strength_reduction
-        n = len(out.points)
-        base = Result(method=out.method, points=out.points, u=np.zeros((n, 2)), stress=np.zeros((n, 3)),
-                      cells=out.cells, counts=dict(out.counts), timings=timer.total(), parameters=out.parameters,
-                      defaults=case.defaults)
-        return solve_strength_reduction(case, system, out, base, progress)
-    if case.problem.analysis == "dynamic":
-        return _relaxed(case, system, out, timer)
-    criterion = (SettlementCriterion.build(system, case.loading.limit_slope)
-                 if case.loading.until_failure and case.loading.limit_slope > 0 else None)
-    path = system.run(case.loading, lambda t: material, lambda t: t, on_converged,
-                      stop_on_failure=case.loading.until_failure, judge=criterion,
-                      recheck=case.loading.until_failure)
-    timer.lap("solve")
-    probes = out.probe_values(path.U, system.stress[:, :3])
-    stress = out.nodal_stress(system.stress)
-    fields = out.plastic_field(system.plastic_strain)
-    timer.lap("postprocess")
-    counts = {**out.counts, "load_increments": sum(h["converged"] for h in path.history),
-              "cutbacks": path.cutbacks, "newton_iterations": path.newton_iterations,
-              "plastic_points": int((system.region != ELASTIC).sum()), **system.iteration_counts()}
-    return Result(
-        method=out.method, points=out.points, u=out.displacement(path.U), **stress, cells=out.cells,
-        probes=probes, errors={}, counts=counts, timings=timer.total(), history=path.history, series=series,
-        outcome=limit_load(path, out.peak_traction, criterion) if case.loading.until_failure else {},
-        fields=fields, parameters=out.parameters, defaults=case.defaults)
-
-
-def _relaxed(case: Case, system: PlasticSystem, out: PlasticOutput, timer: Timer) -> Result:
-    """Dynamic relaxation of the loads applied at once (``analysis = "dynamic"``)."""
-    from ctmrpim.solvers.dynamic_relaxation import relax
-    path = relax(system, case.problem.material, 1.0, case.relaxation)
-    timer.lap("solve")
-    stress = system.stress[:, :3]
-    result = Result(
-        method=out.method, points=out.points, u=out.displacement(system.U), **out.nodal_stress(system.stress),
-        cells=out.cells,
-        probes=out.probe_values(system.U, stress), errors={},
-        counts={**out.counts, "steps": path.steps, "plastic_points": int((system.region != ELASTIC).sum())},
-        timings={}, history=path.history,
-        fields=out.plastic_field(system.plastic_strain),
-        outcome={"relaxation": {"at_rest": path.at_rest, "steps": path.steps, "residual": path.residual}},
-        parameters=out.parameters, defaults=case.defaults)
-    timer.lap("postprocess")
-    result.timings = timer.total()
-    return result
-
-

@@ -44,6 +44,7 @@ from ctmrpim.problem.case import Case
 from ctmrpim.problem.settings import Loading, Relaxation, StrengthReduction
 from ctmrpim.result import Result
 from ctmrpim.solvers.dynamic_relaxation import max_displacement, relax
+from ctmrpim.solvers.plastic_system import PlasticSystem
 from ctmrpim.timing import Timer
 
 CRITERION = {"newton": "displacement runaway or non-convergence: a level is failed when the largest nodal displacement "
@@ -102,7 +103,7 @@ class Level:
                 **({"displacement_history": self.path} if self.path is not None else {})}
 
 
-def _relax_level(system, relaxation: Relaxation, material: MohrCoulomb, srf: float, fixed_values=None) -> Level:
+def _relax_level(system: PlasticSystem, relaxation: Relaxation, material: MohrCoulomb, srf: float, fixed_values=None) -> Level:
     """Dynamic relaxation from the committed state with ``material`` under the full loads."""
     timer = Timer()
     with _progress.current().stage(f"SRF {srf:.4f}"):    # the relaxation's steps, labelled with the level
@@ -118,16 +119,43 @@ def _relax_level(system, relaxation: Relaxation, material: MohrCoulomb, srf: flo
                  f"not at rest, still moving ({100 * growth:.2g} % over the last quarter)", history)
 
 
-def _level(system, loading, material_at, load_at, srf_at: Callable[[float], float], fixed_values=None,
-           recheck: bool = True) -> tuple[Level, Level | None]:
+def _level(system: PlasticSystem, loading, material_at, load_at, srf_at: Callable[[float], float], fixed_values=None,
+           recheck: bool = True, runaway: Callable[[float, np.ndarray], Level] | None = None
+           ) -> tuple[Level, Level | None]:
     """Run the path t = 0..1 from the committed state; returns the level at t = 1 (stable, or failed
-    at the sub-step that did not converge) and, for a failed level whose cut-back sub-steps got part of
-    the way, the stable level reached (the system is left there)."""
+    at the sub-step that did not converge) and, for a failed level whose sub-steps got part of the way, the
+    stable level reached (the system is left there).
+
+    ``runaway(srf, U)``, where given (the search's response criterion), judges every sub-step in equilibrium
+    before the last: one it finds failed ends the level there, failed in equilibrium, and the sub-step before
+    it, where there is one, is the stable level reached. The levels beyond a runaway are failed at least as
+    much (the search would judge one at that SRF the same way: from the same stable level, by the same measure),
+    and the sub-steps after it would spend the iterations of a mechanism: on the 1928-node slope the
+    iterations and cut-backs past SRF 1.356 that the step 1.3 -> 1.4 tried were half the search's time."""
     timer = Timer()
+    carried: list[tuple[float, tuple]] = []          # the last two converged sub-steps: (t, snapshot)
+
+    def converged(t: float, U: np.ndarray) -> dict:
+        carried[:] = [*carried[-1:], (t, system.snapshot())]
+        return {}
+
+    def stop(t: float, U: np.ndarray) -> str | None:
+        level = runaway(srf_at(t), U)
+        return None if level.stable else level.criterion
+
     with _progress.current().stage(f"SRF {srf_at(1.0):.4f}"):   # Newton's increments, labelled with the level
-        path = system.run(loading, material_at, load_at, lambda t, U: {}, fixed_values=fixed_values,
-                          stop_on_failure=True, recheck=recheck)
+        path = system.run(loading, material_at, load_at, converged, fixed_values=fixed_values,
+                          stop_on_failure=True, recheck=recheck, stop=None if runaway is None else stop)
     seconds = timer.elapsed()
+    if path.stopped is not None:
+        t, state = carried[-1]
+        failed = runaway(srf_at(t), state[0])
+        failed.iterations, failed.cutbacks, failed.seconds, failed.state = (path.newton_iterations, path.cutbacks,
+                                                                            seconds, state)
+        if len(carried) < 2:
+            return failed, None
+        t, state = carried[0]
+        return failed, Level(srf_at(t), True, 0, 0, 0.0, state, "reached by the sub-steps of the next level")
     if path.failed_at is None:
         return Level(srf_at(1.0), True, path.newton_iterations, path.cutbacks, seconds, system.snapshot()), None
     failed = Level(srf_at(path.failed_at), False, path.newton_iterations, path.cutbacks, seconds,
@@ -139,18 +167,17 @@ def _level(system, loading, material_at, load_at, srf_at: Callable[[float], floa
                          "reached by the cut-back sub-steps of the next level")
 
 
-def gravity_level(system, loading: Loading, material: MohrCoulomb, srf: float,
+def gravity_level(system: PlasticSystem, loading: Loading, material: MohrCoulomb, srf: float,
                   relaxation: Relaxation | None = None) -> Level:
     """Loads ramped from zero on the reduced material (the first stage of a search; one sweep level);
-    with ``relaxation``, applied at once and relaxed (the paper's way). ``system`` is a
-    :class:`~ctmrpim.solvers.plastic_system.PlasticSystem` (not imported: that module imports this one)."""
+    with ``relaxation``, applied at once and relaxed (the paper's way)."""
     m = reduced(material, srf)
     if relaxation is not None:
         return _relax_level(system, relaxation, m, srf)
     return _level(system, loading, lambda t: m, lambda t: t, lambda t: srf, recheck=False)[0]
 
 
-def search(system, loading: Loading, material: MohrCoulomb, settings: StrengthReduction,
+def search(system: PlasticSystem, loading: Loading, material: MohrCoulomb, settings: StrengthReduction,
            progress: Callable[[Level], None] = lambda level: None,
            relaxation: Relaxation | None = None) -> tuple[list[Level], Level, Level]:
     """Bracket and bisect the factor of safety; returns (levels in order, last stable, first failed
@@ -173,12 +200,18 @@ def search(system, loading: Loading, material: MohrCoulomb, settings: StrengthRe
                                key="strength-reduction.max_srf")
         system.restore(stable.state)
         s0 = stable.srf
+
+        def runaway(srf: float, U: np.ndarray, below: Level = stable) -> Level:
+            level = Level(srf, True, 0, 0, 0.0, (U,))
+            _judge(below, level, reference, settings.limit_growth)
+            return level
+
         srf_at = lambda t, s0=s0, s1=target: s0 + t * (s1 - s0)   # noqa: E731
         if relaxation is not None:     # the strength reduced at once, relaxed from the stable state
             level, reached = _relax_level(system, relaxation, reduced(material, target), target, fixed_values), None
         else:
             level, reached = _level(system, level_loading, lambda t: reduced(material, srf_at(t)), lambda t: 1.0,
-                                    srf_at, fixed_values)
+                                    srf_at, fixed_values, runaway=runaway if settings.limit_growth > 0 else None)
         if reached is not None:   # the cut-back sub-steps converged part of the way: stable there
             _judge(stable, reached, reference, settings.limit_growth)
             progress(reached)
@@ -215,7 +248,7 @@ def _judge(stable: Level, level: Level, reference: float, limit: float) -> None:
                            f"relative SRF rise, above {limit:g}; in equilibrium)")
 
 
-def sweep(system, loading: Loading, material: MohrCoulomb, values: tuple[float, ...],
+def sweep(system: PlasticSystem, loading: Loading, material: MohrCoulomb, values: tuple[float, ...],
           progress: Callable[[Level], None] = lambda level: None, relaxation: Relaxation | None = None
           ) -> list[Level]:
     """Each SRF of ``values`` on its own from ``system``'s committed state (a
@@ -237,11 +270,11 @@ def bracket(levels: list[Level]) -> tuple[float | None, float | None]:
     return stable, failed
 
 
-def solve_strength_reduction(case: Case, system, out, base: Result,
+def solve_strength_reduction(case: Case, system: PlasticSystem, out, base: Result,
                              progress: Callable[[Level], None] = lambda level: None) -> Result:
     """Run the ``[strength-reduction]`` of ``case`` on ``system`` (a
     :class:`ctmrpim.solvers.plastic_system.PlasticSystem` of any discretisation, reported through ``out``, a
-    :class:`ctmrpim.solvers.plastic_system.PlasticOutput`; not imported: that module imports this one) and fill
+    :class:`ctmrpim.solvers.plastic_analysis.PlasticOutput`; not imported: that module imports this one) and fill
     ``base`` with the last stable state, the levels in the history and the series, and the factor of safety as
     a bracket."""
     settings: StrengthReduction = case.strength_reduction

@@ -53,3 +53,21 @@ def test_other_patterns_are_not_taken() -> None:
     assert band.fits(K.copy()) and not band.fits(other)
     sparse_rows = sp.random(400, 400, density=0.01, random_state=3, format="csr") + sp.identity(400, format="csr")
     assert not BandedLU(sparse_rows.tocsr(), np.arange(400)).worthwhile   # a wide band against sparse rows
+
+
+def test_the_cholesky_of_a_symmetric_positive_definite_matrix_solves_as_superlu_does() -> None:
+    """The symmetric part of the grid matrix (diagonally dominant: positive definite) through dpbtrf/dpbtrs, its
+    upper half read from the CSR pattern, equals SuperLU's solution; an indefinite one is refused."""
+    A = _grid_matrix(30, 8, 2, seed=4)
+    K = (0.5 * (A + A.T)).tocsr()
+    K.sort_indices()
+    free = np.setdiff1d(np.arange(K.shape[0]), [0, 1, 7, 40])
+    band = BandedLU(K, free)
+    Kff = K[free][:, free].tocsc()
+    b = np.random.default_rng(5).normal(size=len(free))
+    x = band.cholesky(K).solve(b)
+    assert np.linalg.norm(x - spla.splu(Kff).solve(b)) <= 1e-12 * np.linalg.norm(x)
+    indefinite = K.copy()
+    indefinite.setdiag(-indefinite.diagonal())      # the diagonal is on the pattern: the band is the same
+    with pytest.raises(RuntimeError, match="not positive definite"):
+        band.cholesky(indefinite)

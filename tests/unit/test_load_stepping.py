@@ -100,3 +100,24 @@ def test_a_non_converged_increment_is_handed_over_to_newton_before_a_cut_back() 
                          lambda K, r: r / K[0, 0], lambda t, U: {}, stop_on_failure=True, recheck=True,
                          recheck_assemble=_tanh_body)
     assert failing.cutbacks == 2 and failing.failed_at is not None
+
+
+def test_stop_ends_the_path_at_the_increment_it_names() -> None:
+    """A linear body f_int = u under f_ext = t in ten increments, ``stop`` naming the fourth: the path ends there
+    with the reason recorded, that increment carried (u = 0.4) and none after it; the last increment (t = 1) is
+    never read, so a criterion met only there leaves the path whole."""
+    loading = Loading(steps=10, tolerance=1e-10, max_iterations=10, max_cutbacks=0)
+    K = sp.csr_matrix([[1.0]])
+
+    def path(stop):
+        return step_loads(1, loading, np.array([], int), np.array([]),
+                          lambda U, t: (np.array([t]), U.copy(), K), lambda K, r: r / K[0, 0],
+                          lambda t, U: {}, stop_on_failure=True, stop=stop)
+
+    seen = []
+    stopped = path(lambda t, U: seen.append(t) or ("runaway" if t > 0.35 else None))
+    assert stopped.stopped == "runaway" and np.isclose(stopped.U[0], 0.4)
+    assert np.allclose([h["load_factor"] for h in stopped.history], [0.1, 0.2, 0.3, 0.4])
+    assert np.allclose(seen, [0.1, 0.2, 0.3, 0.4])
+    whole = path(lambda t, U: "runaway" if t > 0.95 else None)
+    assert whole.stopped is None and np.isclose(whole.U[0], 1.0) and len(whole.history) == 10

@@ -11,7 +11,7 @@ from clouds import QUICK_COLUMN
 
 import ctmrpim
 from ctmrpim.materials.mohr_coulomb import equivalent_plastic_strain
-from ctmrpim.solvers import plastic_system
+from ctmrpim.solvers import plastic_analysis
 from ctmrpim.solvers.explicit import output
 
 #: the footing below Prandtl's load on a coarse grid: yielding under the footing's edge, one second's solve
@@ -24,14 +24,14 @@ def spied(monkeypatch):
     """Records, at every nodal output of a quasi-static Mohr-Coulomb run, the largest point value, the nodal
     field written and the L2 projection of the same point values."""
     seen: list[tuple[float, np.ndarray, np.ndarray]] = []
-    original = plastic_system.PlasticOutput.plastic_field
+    original = plastic_analysis.PlasticOutput.plastic_field
 
     def plastic_field(self, plastic_strain):
         out = original(self, plastic_strain)
         eq = equivalent_plastic_strain(plastic_strain)
         seen.append((float(eq.max()), out["plastic_strain"], self.nodal(eq[:, None])[:, 0]))
         return out
-    monkeypatch.setattr(plastic_system.PlasticOutput, "plastic_field", plastic_field)
+    monkeypatch.setattr(plastic_analysis.PlasticOutput, "plastic_field", plastic_field)
     return seen
 
 
