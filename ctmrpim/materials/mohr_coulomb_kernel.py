@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 
 from ctmrpim.errors import ProblemError
-from ctmrpim.materials.mohr_coulomb import APEX, EIGEN_GAP, YIELD_TOL, MohrCoulomb
+from ctmrpim.materials.mohr_coulomb import APEX, COMPLEX_STEP, EIGEN_GAP, YIELD_TOL, MohrCoulomb
 from ctmrpim.materials.objective_stress import hughes_winget_components, rotate_components
 
 _hughes_winget = njit(cache=True, nogil=True)(hughes_winget_components)
@@ -45,24 +45,25 @@ class PointUpdate(NamedTuple):
 @njit(cache=True, nogil=True)
 def _sorted_principal(sxx, syy, sxy, szz):
     """Sorted principal stresses s1 >= s2 >= s3, the in-plane unit eigenvector of the larger in-plane
-    value and the slot of szz: :func:`ctmrpim.materials.mohr_coulomb._principal` for one real stress."""
+    value and the slot of szz: :func:`ctmrpim.materials.mohr_coulomb._principal` for one stress, real or complex
+    (every decision on the real part, as there; np.sqrt is the correctly rounded square root on reals)."""
     centre = 0.5 * (sxx + syy)
     half = 0.5 * (sxx - syy)
-    gap = abs(half) + abs(sxy)
-    tiny = EIGEN_GAP * (abs(centre) + gap + 1e-300)
+    gap = abs(half.real) + abs(sxy.real)
+    tiny = EIGEN_GAP * (abs(centre.real) + gap + 1e-300)
     if gap < tiny:
         sxy = sxy + tiny
-    radius = math.sqrt(half * half + sxy * sxy)
+    radius = np.sqrt(half * half + sxy * sxy)
     big, small = centre + radius, centre - radius
     nx, ny = radius + half, sxy
-    norm = math.sqrt(nx * nx + ny * ny)
-    if abs(norm) < 1e-300:
+    norm = np.sqrt(nx * nx + ny * ny)
+    if abs(norm.real) < 1e-300:
         nx, ny = 0.0, 1.0
     else:
         nx, ny = nx / norm, ny / norm
-    if szz >= big:
+    if szz.real >= big.real:
         return szz, big, small, nx, ny, 0
-    if szz >= small:
+    if szz.real >= small.real:
         return big, szz, small, nx, ny, 1
     return big, small, szz, nx, ny, 2
 
@@ -78,15 +79,15 @@ def _return(s1, s2, s3, G, K, c, sphi, cphi, spsi):
     r3 = 2.0 * G * (1.0 - spsi / 3.0) - 2.0 * K * spsi
     dg = f / a
     m1, m2, m3 = s1 - r1 * dg, s2 + r2 * dg, s3 + r3 * dg
-    if m1 >= m2 and m2 >= m3:
+    if m1.real >= m2.real and m2.real >= m3.real:
         return m1, m2, m3, 1
-    if m2 > m1:
+    if m2.real > m1.real:
         fb = (s2 - s3) + (s2 + s3) * sphi - 2.0 * c * cphi
         b = 2.0 * G * (1.0 - sphi - spsi - sphi * spsi / 3.0) + 4.0 * K * sphi * spsi
         det = a * a - b * b
         ga, gb = (a * f - b * fb) / det, (a * fb - b * f) / det
         e1, e2, e3 = s1 - r1 * ga + r2 * gb, s2 + r2 * ga - r1 * gb, s3 + r3 * (ga + gb)
-        if ga >= 0.0 and gb >= 0.0 and e2 >= e3:
+        if ga.real >= 0.0 and gb.real >= 0.0 and e2.real >= e3.real:
             return e1, e2, e3, 2
     else:
         fb = (s1 - s2) + (s1 + s2) * sphi - 2.0 * c * cphi
@@ -94,7 +95,7 @@ def _return(s1, s2, s3, G, K, c, sphi, cphi, spsi):
         det = a * a - b * b
         ga, gb = (a * f - b * fb) / det, (a * fb - b * f) / det
         e1, e2, e3 = s1 - r1 * (ga + gb), s2 + r2 * ga + r3 * gb, s3 + r3 * ga + r2 * gb
-        if ga >= 0.0 and gb >= 0.0 and e1 >= e2:
+        if ga.real >= 0.0 and gb.real >= 0.0 and e1.real >= e2.real:
             return e1, e2, e3, 3
     apex = c * cphi / sphi if sphi > 0.0 else math.nan      # phi = 0 beyond both edges: no apex
     return apex, apex, apex, 4
@@ -113,7 +114,7 @@ def _trial_and_return(r0, r1, r2, r3, e0, e1, e2, lam, G, K, c, sphi, cphi, spsi
     s1, s2, s3, nx, ny, zslot = _sorted_principal(t0, t1, t2, t3)
     fy = (s1 - s3) + (s1 + s3) * sphi - 2.0 * c * cphi
     reg = 0
-    if fy > YIELD_TOL * (c + max(abs(s1), abs(s2), abs(s3))):
+    if fy.real > YIELD_TOL * (c + max(abs(s1.real), abs(s2.real), abs(s3.real))):
         s1, s2, s3, reg = _return(s1, s2, s3, G, K, c, sphi, cphi, spsi)
         if zslot == 0:
             szz, big, small = s1, s2, s3
@@ -228,3 +229,31 @@ def small_strain_update(material: MohrCoulomb, stress: np.ndarray, dstrain: np.n
         raise ProblemError("Mohr-Coulomb return: a stress state beyond both edges with phi = 0 (no apex); the "
                            "strain increment is too large")
     return out, region
+
+
+@njit(cache=True)
+def _tangent(stress, de, G, K, c, sphi, cphi, spsi, h, out):
+    lam = K - 2.0 * G / 3.0
+    for p in range(stress.shape[0]):
+        for k in range(3):
+            e0 = complex(de[p, 0], h if k == 0 else 0.0)
+            e1 = complex(de[p, 1], h if k == 1 else 0.0)
+            e2 = complex(de[p, 2], h if k == 2 else 0.0)
+            t0, t1, t2, _, _ = _trial_and_return(stress[p, 0], stress[p, 1], stress[p, 2], stress[p, 3], e0, e1,
+                                                 e2, lam, G, K, c, sphi, cphi, spsi)
+            out[p, 0, k], out[p, 1, k], out[p, 2, k] = t0.imag / h, t1.imag / h, t2.imag / h
+
+
+def consistent_tangent(material: MohrCoulomb, stress: np.ndarray, dstrain: np.ndarray) -> np.ndarray:
+    """:meth:`ctmrpim.materials.mohr_coulomb.MohrCoulomb.tangent` compiled, for no tension cut-off: the (m, 3, 3)
+    consistent tangent d(sxx, syy, sxy)_{n+1} / d(exx, eyy, gxy) of the return from ``stress`` (m, 4) by
+    ``dstrain`` (m, 3), by the same three complex steps per point (the compiled return above run on complex
+    numbers, every branch decided on the real part) in one pass instead of three complex numpy passes of about
+    40 arrays each (the implicit solvers' Newton tangents)."""
+    if material.tension is not None:
+        raise ValueError("consistent_tangent: the tension cut-off is not compiled; use MohrCoulomb.tangent")
+    out = np.empty((len(stress), 3, 3))
+    phi, psi = math.radians(material.phi), math.radians(material.psi)
+    _tangent(np.ascontiguousarray(stress, float), np.ascontiguousarray(dstrain, float), material.G, material.K,
+             material.c, math.sin(phi), math.cos(phi), math.sin(psi), COMPLEX_STEP, out)
+    return out

@@ -41,7 +41,7 @@ from threadpoolctl import threadpool_limits
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import ELASTIC, MohrCoulomb, plastic_strain_increment
-from ctmrpim.materials.mohr_coulomb_kernel import small_strain_update
+from ctmrpim.materials.mohr_coulomb_kernel import consistent_tangent, small_strain_update
 from ctmrpim.problem.settings import Loading
 from ctmrpim.solvers.banded_lu import BandedLU
 from ctmrpim.solvers.load_stepping import LoadPath, step_loads
@@ -136,6 +136,14 @@ class PlasticSystem:
             return small_strain_update(material, self.stress, de)
         return material.update(self.stress, de)
 
+    def _material_tangent(self, material: MohrCoulomb, points: np.ndarray, de: np.ndarray) -> np.ndarray:
+        """(k, 3, 3) consistent tangent of the return at the ``points`` (k,) by their strain increments ``de``
+        (k, 3): compiled where there is no tension cut-off (:func:`~ctmrpim.materials.mohr_coulomb_kernel.
+        consistent_tangent`, the same complex steps), else the numpy form."""
+        if material.tension is None:
+            return consistent_tangent(material, self.stress[points], de)
+        return material.tangent(self.stress[points], de)
+
     def commit(self, material: MohrCoulomb, U: np.ndarray) -> None:
         """Make the trial state at U (2n,) under ``material`` the committed one."""
         self.U, self.stress, self.region, self.plastic_strain = self.trial_state(material, U)
@@ -202,7 +210,7 @@ class PlasticSystem:
                 plastic = np.flatnonzero(region != ELASTIC)
                 self._K = self._K_elastic          # its factors are kept while no point is plastic
                 if len(plastic):
-                    dD = material.tangent(self.stress[plastic], de[plastic]) - material.D("strain")[None]
+                    dD = self._material_tangent(material, plastic, de[plastic]) - material.D("strain")[None]
                     self._K = self._plastic_tangent(plastic, dD)
                 self.tangents += 1
         return f_ext, f_int, self._K

@@ -1,5 +1,5 @@
-"""The compiled Mohr-Coulomb point updates (ctmrpim.materials.mohr_coulomb_kernel): the explicit step's, and the
-small-strain return of the implicit solvers' residuals."""
+"""The compiled Mohr-Coulomb point updates (ctmrpim.materials.mohr_coulomb_kernel): the explicit step's, the
+small-strain return of the implicit solvers' residuals and the consistent tangent of their Newton iterations."""
 from __future__ import annotations
 
 import numpy as np
@@ -7,7 +7,7 @@ import pytest
 
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import APEX, ELASTIC, LEFT, MAIN, RIGHT, MohrCoulomb, plastic_strain_increment
-from ctmrpim.materials.mohr_coulomb_kernel import point_update, small_strain_update
+from ctmrpim.materials.mohr_coulomb_kernel import consistent_tangent, point_update, small_strain_update
 from ctmrpim.materials.objective_stress import hughes_winget_c, rotate_c
 
 
@@ -73,3 +73,32 @@ def test_compiled_small_strain_return_matches_the_numpy_form(c, phi, psi):
     with pytest.raises(ValueError, match="tension cut-off"):
         small_strain_update(MohrCoulomb(E=1e7, nu=0.3, c=c, phi=phi, psi=psi, density=2000.0, tension=1e3),
                             stress, de)
+
+
+@pytest.mark.parametrize("c, phi, psi", [(0.0, 30.0, 0.0), (2.0e3, 19.8, 10.0), (1.0e4, 30.0, 30.0), (1.0e4, 0.0, 0.0)])
+def test_compiled_consistent_tangent_matches_the_numpy_form(c, phi, psi):
+    """The compiled tangent is MohrCoulomb.tangent (the same complex steps) in every return region, to round-off of
+    the elastic moduli: D itself where elastic, symmetric on the main plane with associated flow (psi = phi),
+    singular at the apex; the tension cut-off is not compiled and says so."""
+    material = MohrCoulomb(E=1e7, nu=0.3, c=c, phi=phi, psi=psi, density=2000.0)
+    rng = np.random.default_rng(3)
+    m = 5000
+    p = rng.uniform(-500.0, 4e4, m)
+    stress = np.c_[-p * rng.uniform(0.3, 1.2, m), -p, p * rng.uniform(-0.4, 0.4, m), -p * rng.uniform(0.5, 1.0, m)]
+    stress, _ = material.update(stress, np.zeros((m, 3)))
+    de = 10.0 ** rng.uniform(-6, -2.5, (m, 1)) * rng.standard_normal((m, 3))
+    if phi == 0:
+        de *= 1e-2
+    _, region = small_strain_update(material, stress, de)
+    assert {ELASTIC, MAIN, RIGHT, LEFT} <= set(region) and (c > 0 or phi == 0 or APEX in set(region))
+    got, want = consistent_tangent(material, stress, de), material.tangent(stress, de)
+    D = material.D("strain")
+    assert np.abs(got - want).max() < 1e-13 * np.abs(D).max()
+    assert np.abs(got[region == ELASTIC] - D).max() < 1e-13 * np.abs(D).max()
+    if phi == psi:
+        main = got[region == MAIN]
+        assert np.abs(main - main.transpose(0, 2, 1)).max() < 1e-12 * np.abs(D).max()
+    if APEX in set(region):
+        assert np.abs(got[region == APEX]).max() < 1e-12 * np.abs(D).max()
+    with pytest.raises(ValueError, match="tension cut-off"):
+        consistent_tangent(MohrCoulomb(E=1e7, nu=0.3, c=c, phi=phi, psi=psi, density=2000.0, tension=1e3), stress, de)
