@@ -12,8 +12,10 @@ block of points: :mod:`ctmrpim.solvers.explicit.point_pass`). Measured in one sc
 (Mohr-Coulomb states, 11 % of them yielding): 0.75 ms per step against 4.1 ms for the numpy forms; on the
 1071-node column's 9625 points, one thread, 0.46 ms.
 
-The numpy forms stay the definition (they take complex steps for the implicit solvers' tangents);
-``tests/unit/test_mohr_coulomb_kernel.py`` checks this kernel against them point for point in every return
+The same return serves the implicit solvers: their residuals' small-strain update (:func:`small_strain_update`)
+and their Newton tangents' complex steps (:func:`consistent_tangent`), the return's kernels compiled for real and
+for complex numbers alike. The numpy forms stay the definition (and the tension cut-off's only form);
+``tests/unit/test_mohr_coulomb_kernel.py`` checks these kernels against them point for point in every return
 region (elastic, main plane, both edges, apex), to round-off.
 """
 from __future__ import annotations
@@ -217,7 +219,7 @@ def small_strain_update(material: MohrCoulomb, stress: np.ndarray, dstrain: np.n
     """:meth:`ctmrpim.materials.mohr_coulomb.MohrCoulomb.update` compiled, for real increments and no tension
     cut-off: the stress (m, 4) after the strain increments ``dstrain`` (m, 3: exx, eyy, gxy) from ``stress``
     (m, 4), and the return region of each point. One pass over the points instead of about 40 array passes
-    (the implicit solvers' residuals; their tangents keep the numpy form's complex steps)."""
+    (the implicit solvers' residuals; their tangents: :func:`consistent_tangent`)."""
     if material.tension is not None:
         raise ValueError("small_strain_update: the tension cut-off is not compiled; use MohrCoulomb.update")
     m = len(stress)
