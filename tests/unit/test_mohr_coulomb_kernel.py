@@ -46,20 +46,24 @@ def test_compiled_point_update_matches_the_numpy_forms(c, psi):
     assert work == pytest.approx(w[~dead] @ strain[~dead].sum(axis=1), rel=1e-12)   # unit old viscous stress
 
 
+def _admissible_states(material: MohrCoulomb, seed: int, m: int = 5000) -> tuple[np.ndarray, np.ndarray]:
+    """m admissible stresses (m, 4), compressive mostly, and strain increments (m, 3) from 1e-6 to 3e-3 that take
+    them to every return region (within the edges where phi = 0: a Tresca body has no apex to return to)."""
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(-500.0, 4e4, m)
+    stress = np.c_[-p * rng.uniform(0.3, 1.2, m), -p, p * rng.uniform(-0.4, 0.4, m), -p * rng.uniform(0.5, 1.0, m)]
+    stress, _ = material.update(stress, np.zeros((m, 3)))
+    de = 10.0 ** rng.uniform(-6, -2.5, (m, 1)) * rng.standard_normal((m, 3))
+    return stress, de * (1e-2 if material.phi == 0 else 1.0)
+
+
 @pytest.mark.parametrize("c, phi, psi", [(0.0, 30.0, 0.0), (2.0e3, 19.8, 10.0), (1.0e4, 30.0, 30.0), (1.0e4, 0.0, 0.0)])
 def test_compiled_small_strain_return_matches_the_numpy_form(c, phi, psi):
     """The implicit solvers' compiled return is MohrCoulomb.update point for point, every region (the apex where
     phi > 0), to round-off; beyond both edges with phi = 0 (no apex) it refuses as the numpy form does; the
     tension cut-off is not compiled and says so."""
     material = MohrCoulomb(E=1e7, nu=0.3, c=c, phi=phi, psi=psi, density=2000.0)
-    rng = np.random.default_rng(11)
-    m = 5000
-    p = rng.uniform(-500.0, 4e4, m)
-    stress = np.c_[-p * rng.uniform(0.3, 1.2, m), -p, p * rng.uniform(-0.4, 0.4, m), -p * rng.uniform(0.5, 1.0, m)]
-    stress, _ = material.update(stress, np.zeros((m, 3)))
-    de = 10.0 ** rng.uniform(-6, -2.5, (m, 1)) * rng.standard_normal((m, 3))
-    if phi == 0:
-        de *= 1e-2          # within the edges: a Tresca body has no apex to return to
+    stress, de = _admissible_states(material, seed=11)
     try:
         want, want_region = material.update(stress, de)
     except ProblemError:
@@ -81,14 +85,7 @@ def test_compiled_consistent_tangent_matches_the_numpy_form(c, phi, psi):
     the elastic moduli: D itself where elastic, symmetric on the main plane with associated flow (psi = phi),
     singular at the apex; the tension cut-off is not compiled and says so."""
     material = MohrCoulomb(E=1e7, nu=0.3, c=c, phi=phi, psi=psi, density=2000.0)
-    rng = np.random.default_rng(3)
-    m = 5000
-    p = rng.uniform(-500.0, 4e4, m)
-    stress = np.c_[-p * rng.uniform(0.3, 1.2, m), -p, p * rng.uniform(-0.4, 0.4, m), -p * rng.uniform(0.5, 1.0, m)]
-    stress, _ = material.update(stress, np.zeros((m, 3)))
-    de = 10.0 ** rng.uniform(-6, -2.5, (m, 1)) * rng.standard_normal((m, 3))
-    if phi == 0:
-        de *= 1e-2
+    stress, de = _admissible_states(material, seed=3)
     _, region = small_strain_update(material, stress, de)
     assert {ELASTIC, MAIN, RIGHT, LEFT} <= set(region) and (c > 0 or phi == 0 or APEX in set(region))
     got, want = consistent_tangent(material, stress, de), material.tangent(stress, de)
