@@ -104,7 +104,8 @@ class PlasticSystem:
     nodes: np.ndarray | None = None         # (n, 2) where the dofs 2i, 2i + 1 sit, for the band's ordering, if known
 
     def __post_init__(self) -> None:
-        self.GT = (self.G if self.test is None else self.test).T
+        # G~^T for the sparse products; the compiled ones read G's pattern transposed themselves
+        self.GT = None if self.products is not None else (self.G if self.test is None else self.test).T
         self.U = np.zeros(self.G.shape[1])
         self.stress = np.zeros((len(self.w), 4))
         self.region = np.zeros(len(self.w), dtype=np.int8)
@@ -158,7 +159,9 @@ class PlasticSystem:
         if self._K_elastic is None:
             D = self.material.D("strain")
             A = np.broadcast_to(TO_P @ D @ FROM_GRAD, (len(self.w), 4, 4))
-            self._K_elastic = tangent(self.G, A, self.w, self.GT)
+            # the compiled pass where there is one: its interleaved node pattern is what the plastic corrections add to
+            self._K_elastic = (tangent(self.G, A, self.w, self.GT) if self.products is None
+                               else self.products.tangent(A))
             if self.consistent:
                 self._K_elastic = self._K_elastic - self.dirichlet.stiffness(self.G, np.ascontiguousarray(A))
         return self._K_elastic
