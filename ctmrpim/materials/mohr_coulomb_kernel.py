@@ -175,6 +175,22 @@ def update_rows(f, stress, plastic, viscous, dead, w, G, K, c, sphi, cphi, spsi,
         dissipation[p] = w[p] * 0.5 * ((r0 + t0) * dp0 + (r1 + t1) * dp1 + 2.0 * (r2 + t2) * dp2 + (r3 + t3) * dp3)
 
 
+def return_constants(material: MohrCoulomb, caller: str, instead: str = "the numpy forms") -> tuple[float, ...]:
+    """(G, K, c, sin phi, cos phi, sin psi): the material as the compiled return takes it. The tension cut-off is
+    not compiled: ``caller`` refuses it, naming what to use ``instead``."""
+    if material.tension is not None:
+        raise ValueError(f"{caller}: the tension cut-off is not compiled; use {instead}")
+    phi, psi = math.radians(material.phi), math.radians(material.psi)
+    return material.G, material.K, material.c, math.sin(phi), math.cos(phi), math.sin(psi)
+
+
+def refuse_no_apex(material: MohrCoulomb, region: np.ndarray) -> None:
+    """Refuse returns to the apex with phi = 0, where there is none (the compiled return leaves them NaN)."""
+    if material.phi == 0 and np.any(region == APEX):
+        raise ProblemError("Mohr-Coulomb return: a stress state beyond both edges with phi = 0 (no apex); the "
+                           "strain increment is too large")
+
+
 def point_update(material: MohrCoulomb, f: np.ndarray, stress: np.ndarray, plastic: np.ndarray,
                  dead: np.ndarray, w: np.ndarray, viscous: np.ndarray | None = None,
                  beta_dt: float = 0.0) -> PointUpdate:
@@ -185,21 +201,16 @@ def point_update(material: MohrCoulomb, f: np.ndarray, stress: np.ndarray, plast
     viscous stress of the step, beta D d eps / dt (stiffness-proportional damping), and the work that the
     last step's viscous stress ``viscous`` did on this step's strain. Points marked ``dead`` come out
     stress-free with no plastic strain. Mohr-Coulomb without a tension cut-off only."""
-    if material.tension is not None:
-        raise ValueError("point_update: the tension cut-off is not compiled; use the numpy forms")
+    constants = return_constants(material, "point_update")
     m = len(f)
     out_stress, out_plastic, out_viscous = np.empty((m, 4)), np.empty((m, 4)), np.empty((m, 4))
     region, dissipation, viscous_work = np.empty(m, np.int8), np.empty(m), np.empty(m)
-    phi, psi = math.radians(material.phi), math.radians(material.psi)
     viscous = np.zeros((m, 4)) if viscous is None else np.ascontiguousarray(viscous, float)
     update_rows(np.ascontiguousarray(f, float), np.ascontiguousarray(stress, float),
                 np.ascontiguousarray(plastic, float), viscous, np.ascontiguousarray(dead, np.bool_),
-                np.ascontiguousarray(w, float), material.G, material.K,
-                material.c, math.sin(phi), math.cos(phi), math.sin(psi), material.E, material.nu, float(beta_dt),
+                np.ascontiguousarray(w, float), *constants, material.E, material.nu, float(beta_dt),
                 out_stress, out_plastic, out_viscous, region, dissipation, viscous_work, 0, m)
-    if material.phi == 0 and np.any(region == APEX):
-        raise ProblemError("Mohr-Coulomb return: a stress state beyond both edges with phi = 0 (no apex); the "
-                           "strain increment is too large")
+    refuse_no_apex(material, region)
     return PointUpdate(out_stress, out_plastic, region, float(dissipation.sum()), out_viscous,
                        float(viscous_work.sum()))
 
@@ -220,16 +231,11 @@ def small_strain_update(material: MohrCoulomb, stress: np.ndarray, dstrain: np.n
     cut-off: the stress (m, 4) after the strain increments ``dstrain`` (m, 3: exx, eyy, gxy) from ``stress``
     (m, 4), and the return region of each point. One pass over the points instead of about 40 array passes
     (the implicit solvers' residuals; their tangents: :func:`consistent_tangent`)."""
-    if material.tension is not None:
-        raise ValueError("small_strain_update: the tension cut-off is not compiled; use MohrCoulomb.update")
+    constants = return_constants(material, "small_strain_update", "MohrCoulomb.update")
     m = len(stress)
     out, region = np.empty((m, 4)), np.empty(m, np.int8)
-    phi, psi = math.radians(material.phi), math.radians(material.psi)
-    _small_strain(np.ascontiguousarray(stress, float), np.ascontiguousarray(dstrain, float), material.G,
-                  material.K, material.c, math.sin(phi), math.cos(phi), math.sin(psi), out, region)
-    if material.phi == 0 and np.any(region == APEX):
-        raise ProblemError("Mohr-Coulomb return: a stress state beyond both edges with phi = 0 (no apex); the "
-                           "strain increment is too large")
+    _small_strain(np.ascontiguousarray(stress, float), np.ascontiguousarray(dstrain, float), *constants, out, region)
+    refuse_no_apex(material, region)
     return out, region
 
 
@@ -252,10 +258,8 @@ def consistent_tangent(material: MohrCoulomb, stress: np.ndarray, dstrain: np.nd
     ``dstrain`` (m, 3), by the same three complex steps per point (the compiled return above run on complex
     numbers, every branch decided on the real part) in one pass instead of three complex numpy passes of about
     40 arrays each (the implicit solvers' Newton tangents)."""
-    if material.tension is not None:
-        raise ValueError("consistent_tangent: the tension cut-off is not compiled; use MohrCoulomb.tangent")
+    constants = return_constants(material, "consistent_tangent", "MohrCoulomb.tangent")
     out = np.empty((len(stress), 3, 3))
-    phi, psi = math.radians(material.phi), math.radians(material.psi)
-    _tangent(np.ascontiguousarray(stress, float), np.ascontiguousarray(dstrain, float), material.G, material.K,
-             material.c, math.sin(phi), math.cos(phi), math.sin(psi), COMPLEX_STEP, out)
+    _tangent(np.ascontiguousarray(stress, float), np.ascontiguousarray(dstrain, float), *constants, COMPLEX_STEP,
+             out)
     return out

@@ -29,7 +29,6 @@ uninterrupted one bit for bit).
 """
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
 import numpy as np
@@ -38,9 +37,8 @@ from numba import njit
 from ctmrpim.discretisation import thread_blocks
 from ctmrpim.discretisation.configuration import Configuration
 from ctmrpim.discretisation.gradient_operator import add_blocks, gradient_rows, scatter_rows
-from ctmrpim.errors import ProblemError
-from ctmrpim.materials.mohr_coulomb import APEX, MohrCoulomb
-from ctmrpim.materials.mohr_coulomb_kernel import update_rows
+from ctmrpim.materials.mohr_coulomb import MohrCoulomb
+from ctmrpim.materials.mohr_coulomb_kernel import refuse_no_apex, return_constants, update_rows
 from ctmrpim.materials.objective_stress_kernels import stretch_strain, weighted_first_piola_rows
 
 #: points a block goes through the pass's loops in at a time: their rows (about 43 entries each on the column's
@@ -113,8 +111,7 @@ def point_pass(frame: Configuration, d: np.ndarray, F: np.ndarray, stress: np.nd
     ``force``: also F_int = sum_p w_r P grad_r N of the new state (its viscous stress added where ``with_viscous``),
     the bits of :meth:`~ctmrpim.discretisation.gradient_operator.GradientOperator.scatter_force` of the new state's
     w_r P (points that the step inverted count as they will once dropped: no stress)."""
-    if material.tension is not None:
-        raise ValueError("point_pass: the tension cut-off is not compiled; use the numpy forms")
+    constants = return_constants(material, "point_pass")
     op = frame.compiled_gradient()
     m, blocks = len(frame.w), op.scatter_blocks
     F_new, f, out_stress, out_plastic, out_viscous = (np.empty((m, 4)) for _ in range(5))
@@ -122,16 +119,13 @@ def point_pass(frame: Configuration, d: np.ndarray, F: np.ndarray, stress: np.nd
     wJ, dissipation, viscous_work, strain = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
     wP = np.empty((m, 4)) if force else np.empty((0, 4))
     parts = np.zeros((max(len(blocks), 1), op.shape[1], 2) if force else (1, 0, 2))
-    phi, psi = math.radians(material.phi), math.radians(material.psi)
     f64 = lambda a: np.ascontiguousarray(a, float)
     args = (op.indptr, op.indices, op.dx, op.dy, f64(d), f64(F), f64(stress), f64(plastic), f64(viscous), frame.w,
-            material.G, material.K, material.c, math.sin(phi), math.cos(phi), math.sin(psi), material.E, material.nu,
+            *constants, material.E, material.nu,
             float(beta_dt), bool(with_viscous), bool(force), F_new, f, dead, wJ, out_stress, out_plastic, out_viscous,
             region, inverted, dissipation, viscous_work, strain, wP, parts)
     thread_blocks.run_blocks(lambda bab: _points(*args, *bab), blocks, kernel=_points)
-    if material.phi == 0 and np.any(region == APEX):
-        raise ProblemError("Mohr-Coulomb return: a stress state beyond both edges with phi = 0 (no apex); the "
-                           "strain increment is too large")
+    refuse_no_apex(material, region)
     return PointPass(F_new, out_stress, out_plastic, out_viscous, inverted, float(dissipation.sum()),
                      float(viscous_work.sum()), float(strain.max()) if m else 0.0,   # NaN wins the max
                      add_blocks(parts) if force else None)
