@@ -27,6 +27,7 @@ import numpy as np
 import pandas as pd
 
 DEFAULT_GRIDS = "33x9,129x33,257x65"
+TIME_TO_TARGET = 1e-3   # the tip error whose time to reach is printed (issue target: CTM-RPIM / Q1 <= 1.5)
 #: (label, solver, element or integration)
 METHODS = (("ctm-rpim", "ctm-rpim", None), ("ctm-rpim/ctm", "ctm-rpim", "ctm"),
            ("fem-q1", "fem", "q1"), ("fem-p2", "fem", "p2"))
@@ -137,6 +138,24 @@ def main() -> None:
                     if le.min() <= x <= le.max():
                         t_fem = float(np.exp(np.interp(x, le, lt)))
                         print(f"  {ours} / {m} at {100 * r.tip_error:.4f} % ({r.grid}): time x{r.t_total / t_fem:.2f}")
+        print_time_to(df, TIME_TO_TARGET)
+
+
+def print_time_to(df: pd.DataFrame, target: float) -> None:
+    """Each method's time to ``target`` tip error, interpolated in log-log between the grids that bracket it
+    (the time-to-accuracy study's rule), from the best total and from the first solve (a process that solves
+    once), and CTM-RPIM's ratios to the FEM references."""
+    from studies.time_to_accuracy import time_to_reach
+
+    print(f"\ntime to {100 * target:g} % tip error (log-log between the bracketing grids; best total, first solve):")
+    times = {m: {k: time_to_reach(d.rename(columns={"n": "nodes", col: "time_s"}), target)
+                 for k, col in (("best", "t_total"), ("first", "first"))}
+             for m, d in df.groupby("method")}
+    for m, t in times.items():
+        ratios = "" if not m.startswith("ctm-rpim") else "  " + "; ".join(
+            f"/ {f}: x{t['best'] / times[f]['best']:.2f} (first x{t['first'] / times[f]['first']:.2f})"
+            for f in times if f.startswith("fem"))
+        print(f"  {m:13s} {t['best']:.3f} s (first {t['first']:.3f} s){ratios}")
 
 
 if __name__ == "__main__":

@@ -32,7 +32,8 @@ from ctmrpim.discretisation.ctm import BoundaryQuadrature, Quadrature, integrati
 from ctmrpim.discretisation.gradient_operator import GradientOperator
 from ctmrpim.discretisation.lagrangian_operators import gradient_operator
 from ctmrpim.discretisation.nodal_integration import NodalIntegration, smoothed_gradients
-from ctmrpim.discretisation.rpim import ShapeFunctions, shape_functions
+from ctmrpim.discretisation.rpim import COMPILED_MIN_POINTS, ShapeFunctions, shape_functions
+from ctmrpim.discretisation.rpim_kernels import use_compiled
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.objective_stress import inv2
 from ctmrpim.problem.case import Case
@@ -69,6 +70,10 @@ class Configuration:
     #: the force's test gradients where they are not the trial ones (a measurement's corrected gradients;
     #: None: the RPIM gradients, the only ones of a solver)
     tested: GradientOperator | None = field(default=None, repr=False)
+    #: :meth:`shape_functions_at`'s ``compiled_from``: 0 where the configuration's own points took the compiled
+    #: kernels (numba has started: a few thousand error points or probes then cost a tenth of their numpy time),
+    #: else the build's (by the sizes of the input alone, as every such choice)
+    compiled_from: int | None = None
 
     @property
     def N(self) -> sp.csr_matrix:
@@ -87,6 +92,7 @@ class Configuration:
     def shape_functions_at(self, points: np.ndarray, derivatives: bool = True, **options: Any) -> ShapeFunctions:
         """RPIM of this configuration's nodes at other ``points`` (k, 2): probes, tractions, error points
         (``options``: ``reference`` or the other keywords of :func:`~ctmrpim.discretisation.rpim.shape_functions`)."""
+        options.setdefault("compiled_from", self.compiled_from)
         return shape_functions(self.x, points, derivatives=derivatives, tree=self.tree, **options,
                                **self.lengths.rpim())
 
@@ -165,7 +171,9 @@ def build(x: np.ndarray, boundary: Boundary, points: np.ndarray, w: np.ndarray, 
         N, dx, dy = (sp.csr_matrix((M.data, active[M.indices], M.indptr), shape=shape)
                      for M in (sf.N, sf.dNdx, sf.dNdy))
         sf = ShapeFunctions(N, dx, dy, sf.support_sizes, sf.dropped)
-    return Configuration(x, lengths, boundary, points, w, sf, tree, active, quadrature)
+    compiled = use_compiled(len(points), COMPILED_MIN_POINTS if compiled_from is None else compiled_from)
+    return Configuration(x, lengths, boundary, points, w, sf, tree, active, quadrature,
+                         compiled_from=0 if compiled else compiled_from)
 
 
 def lay_points(loops: list[np.ndarray], lengths: ScaledMethod, thickness: float) -> tuple[Quadrature, np.ndarray]:

@@ -1,5 +1,5 @@
 """Compiled (numba) passes of the linear solve over a sparse matrix's arrays: the free-free block of the
-constrained system (whole, as CSC, or its upper triangle), the product with a matrix held by its upper
+constrained system (whole, as CSR, or its upper triangle), the product with a matrix held by its upper
 triangle, and the band of a symmetrically permuted matrix in LAPACK's storage (its width and its fill).
 
 Why compiled: scipy's slicing of the free block copies K's rows and then its columns (160 MB each at 257 x 65
@@ -13,47 +13,49 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
-def constrained_csc(indptr, indices, data, new, values_at, rhs):
-    """The free-free block of a CSR matrix as CSC arrays, in one pass each way: ``new[i]`` the free index of
-    row/column i or -1 where it is prescribed; rhs[new[r]] -= sum over prescribed columns c of A[r, c]
-    values_at[c] (the prescribed values moved to the right-hand side). Row indices ascend in each column."""
+def constrained_csr(indptr, indices, data, new, values_at, rhs):
+    """The free-free block of a CSR matrix as CSR arrays, row by row (no scatter: a column-wise copy took five
+    times as long at 129 x 33 nodes): ``new[i]`` the free index of row/column i or -1 where it is prescribed;
+    rhs[new[r]] -= sum over prescribed columns c of A[r, c] values_at[c] (the prescribed values moved to the
+    right-hand side). Columns keep their order in each row (``new`` is increasing on the free dofs)."""
     nf = 0
     for i in range(len(new)):
         if new[i] >= 0:
             nf += 1
-    cptr = np.zeros(nf + 1, np.int64)
-    for r in range(len(indptr) - 1):
-        if new[r] < 0:
-            continue
-        for k in range(indptr[r], indptr[r + 1]):
-            c = new[indices[k]]
-            if c >= 0:
-                cptr[c + 1] += 1
-    for c in range(nf):
-        cptr[c + 1] += cptr[c]
-    fill = cptr[:-1].copy()
-    rows = np.empty(cptr[nf], indices.dtype)
-    vals = np.empty(cptr[nf])
+    rptr = np.zeros(nf + 1, np.int64)
     for r in range(len(indptr) - 1):
         nr = new[r]
         if nr < 0:
             continue
+        count = 0
+        for k in range(indptr[r], indptr[r + 1]):
+            if new[indices[k]] >= 0:
+                count += 1
+        rptr[nr + 1] = count
+    for i in range(nf):
+        rptr[i + 1] += rptr[i]
+    cols = np.empty(rptr[nf], indices.dtype)
+    vals = np.empty(rptr[nf])
+    for r in range(len(indptr) - 1):
+        nr = new[r]
+        if nr < 0:
+            continue
+        t = rptr[nr]
         for k in range(indptr[r], indptr[r + 1]):
             c = new[indices[k]]
             if c >= 0:
-                t = fill[c]
-                rows[t] = nr
+                cols[t] = c
                 vals[t] = data[k]
-                fill[c] = t + 1
+                t += 1
             else:
                 rhs[nr] -= data[k] * values_at[indices[k]]
-    return cptr, rows, vals
+    return rptr, cols, vals
 
 
 @njit(cache=True, nogil=True)
 def constrained_upper(indptr, indices, data, new, values_at, rhs):
     """The upper triangle (diagonal included) of the free-free block of a symmetric CSR matrix with sorted
-    columns, as CSR arrays (half the entries of :func:`constrained_csc`'s block), and its right-hand side as
+    columns, as CSR arrays (half the entries of :func:`constrained_csr`'s block), and its right-hand side as
     there, from the whole rows: ``new[i]`` the free index of row/column i or -1 where it is prescribed."""
     nf = 0
     for i in range(len(new)):

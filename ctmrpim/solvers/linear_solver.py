@@ -146,13 +146,15 @@ def _solve(Kff: Matrix, rhs: np.ndarray, solver: str, symmetric: bool,
         return _pardiso(Kff, rhs, symmetric)
     if isinstance(Kff, SymmetricHalf):   # auto, where neither the band nor PARDISO took it
         Kff = Kff.full()
+    # a CSR block's arrays are the CSC of its transpose: SuperLU factorises that, and solves transposed (no copy)
+    transposed = isinstance(Kff, sp.csr_matrix)
+    A = sp.csc_matrix((Kff.data, Kff.indices, Kff.indptr), shape=Kff.shape[::-1]) if transposed else Kff.tocsc()
     try:
-        lu = spla.splu(Kff.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                       options={"SymmetricMode": True})
+        lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
     except RuntimeError as exc:  # "Factor is exactly singular"
         raise ProblemError(f"the stiffness matrix is singular ({exc}): the constraints do not prevent "
                            "rigid-body motion, or part of the body is detached") from None
-    return lu.solve(rhs)
+    return lu.solve(rhs, trans="T" if transposed else "N")
 
 
 def _pardiso(A: Matrix, b: np.ndarray, symmetric: bool) -> np.ndarray:
@@ -212,7 +214,7 @@ def _amg(A: sp.csr_matrix | sp.csc_matrix, b: np.ndarray, symmetric: bool, modes
 def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray, half: bool = False
                 ) -> tuple[Matrix, np.ndarray]:
     """K's free-free block and the right-hand side F[free] - K[free, fixed] U[fixed] (U zero on the free dofs).
-    For a large K one compiled pass builds the block as CSC (what SuperLU takes), or with ``half`` its upper
+    For a large K one compiled pass builds the block as CSR (row by row), or with ``half`` its upper
     triangle as a :class:`SymmetricHalf`: no copies of K's rows and columns on the way, which at 257 x 65 nodes
     are 160 MB each. The right-hand side's sums differ from scipy's by round-off, so the path is chosen by size
     alone (a resumed run repeats the first)."""
@@ -230,9 +232,9 @@ def _free_block(K: sp.csr_matrix, F: np.ndarray, free: np.ndarray, U: np.ndarray
         upper = sp.csr_matrix((vals, cols, rptr.astype(itype)), shape=(len(free), len(free)), copy=False)
         upper.has_sorted_indices = True
         return SymmetricHalf(upper), rhs
-    cptr, rows, vals = free_block_kernels.constrained_csc(K.indptr, K.indices, K.data, new, U, rhs)
-    A = sp.csc_matrix((vals, rows, cptr.astype(itype)), shape=(len(free), len(free)), copy=False)
-    A.has_sorted_indices = True
+    rptr, cols, vals = free_block_kernels.constrained_csr(K.indptr, K.indices, K.data, new, U, rhs)
+    A = sp.csr_matrix((vals, cols, rptr.astype(itype)), shape=(len(free), len(free)), copy=False)
+    A.has_sorted_indices = K.has_sorted_indices
     return A, rhs
 
 

@@ -226,7 +226,7 @@ def test_numpy_paths_give_the_compiled_results(jittered, monkeypatch) -> None:
 
 @pytest.mark.parametrize("solver", ["superlu", "banded"])
 def test_constrained_solve_builds_the_free_block_in_one_pass(monkeypatch, solver: str) -> None:
-    """The compiled free-free block (CSC) and right-hand side give scipy's slicing's solution."""
+    """The compiled free-free block (CSR) and right-hand side give scipy's slicing's solution."""
     from ctmrpim.solvers import linear_solver
     rng = np.random.default_rng(0)
     n = 80
