@@ -9,7 +9,8 @@ loaded there), the best total of the repeats and its phases, and the process's m
 (``ru_maxrss`` of the child) after all the repeats and after the first solve (a process that solves once, as
 ``ctmrpim run`` does; the repeats add the allocator's fragmentation). Methods: CTM-RPIM with the default integration (``ctm-vci``) and with the
 paper's ``ctm``, scikit-fem Q1 and P2. Then the CTM-RPIM / FEM time ratios at equal grid, and, with three
-grids or more, the scaling exponent of each phase (time ~ n^p) and the ratios at equal tip error. BLAS
+grids or more, the scaling exponent of each phase (time ~ n^p), the ratios at equal tip error and each method's
+time to 0.1 % tip error (log-log between the bracketing grids, from the best and from the first solve). BLAS
 threads follow the environment. Timings on a shared machine are noisy: the minimum over repeats is the
 figure to compare.
 """
