@@ -22,6 +22,9 @@ from typing import Any, Callable
 THREADS = 2
 
 _pool: tuple[int, int, ThreadPoolExecutor] | None = None     # (process, threads, pool)
+#: the numba dispatchers known to have run in this process: asking a dispatcher for its ``signatures`` costs about
+#: 50 us (it hashes its types), more than one block of a small pass (an explicit step calls run_blocks once or twice)
+_loaded: set[int] = set()
 
 
 def executor() -> ThreadPoolExecutor:
@@ -40,8 +43,11 @@ def run_blocks(work: Callable[[tuple[int, int]], Any], blocks: list[tuple[int, i
     first, so that its cached code is loaded once (two first calls at once load it twice: 15 ms each for the RPIM
     rows, measured)."""
     blocks = list(blocks)
-    if kernel is not None and blocks and not getattr(kernel, "signatures", True):
-        work(blocks.pop(0))
+    if kernel is not None and id(kernel) not in _loaded:
+        if blocks and not getattr(kernel, "signatures", True):
+            work(blocks.pop(0))
+        if getattr(kernel, "signatures", True):
+            _loaded.add(id(kernel))
     if len(blocks) <= 1 or THREADS <= 1:
         for ab in blocks:
             work(ab)

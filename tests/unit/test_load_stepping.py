@@ -7,7 +7,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ctmrpim.problem.settings import Loading
-from ctmrpim.solvers.load_stepping import NEWTON_ITERATIONS, RECHECK_LIMIT, step_loads
+from ctmrpim.solvers.load_stepping import HAND_OVER_RISES, NEWTON_ITERATIONS, RECHECK_LIMIT, step_loads
 
 
 def _run(kappa: float, recheck: bool = True, newton=None):
@@ -100,6 +100,23 @@ def test_a_non_converged_increment_is_handed_over_to_newton_before_a_cut_back() 
                          lambda K, r: r / K[0, 0], lambda t, U: {}, stop_on_failure=True, recheck=True,
                          recheck_assemble=_tanh_body)
     assert failing.cutbacks == 2 and failing.failed_at is not None
+
+
+def test_a_hand_over_whose_residual_keeps_rising_gives_up_early() -> None:
+    """A hand-over's Newton whose residual rises HAND_OVER_RISES times in a row after its second iteration is out of
+    the basin: the increment is cut back then, not after NEWTON_ITERATIONS. f_int = 0.4 tanh(u) under f_ext = 0.5 t
+    with the 'tangent' -1: every step goes the wrong way, the residual rising in every iteration but by steps too
+    short for the divergence test; the re-check of the last increment keeps its whole cap."""
+    def body(U, t, K):
+        return np.array([0.5 * t]), 0.4 * np.tanh(U), sp.csr_matrix([[K]])
+    loading = Loading(steps=1, tolerance=1e-6, max_iterations=10, max_cutbacks=1)
+    path = step_loads(1, loading, np.array([], int), np.array([]), lambda U, t: body(U, t, 1e5),
+                      lambda K, r: r / K[0, 0], lambda t, U: {}, stop_on_failure=True, recheck=True,
+                      recheck_assemble=lambda U, t: body(U, t, -1.0))
+    first = path.history[0]
+    assert not first["converged"] and "cut back" in first["note"]
+    assert first["iterations"] == 2 + HAND_OVER_RISES < NEWTON_ITERATIONS
+    assert path.failed_at is not None and path.history[-1]["iterations"] > 2 + HAND_OVER_RISES
 
 
 def test_stop_ends_the_path_at_the_increment_it_names() -> None:
