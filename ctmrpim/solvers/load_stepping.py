@@ -33,19 +33,19 @@ growing back beyond them.
 ``recheck``: an increment still not converged when the cut-backs are spent is tried once more before its
 non-convergence counts (then judged like any converged one); the history says so. With an iteration on a fixed
 matrix, every increment it does not converge is first handed over to Newton on the consistent tangent from its last
-iterate (up to ``NEWTON_ITERATIONS``; fewer where its residual keeps rising, ``HAND_OVER_RISES``) before it is cut
-back: near a limit the fixed-matrix iteration gives up at levels where Newton converges in 3-13 iterations (measured
-on the 1928-node slope: every one of its eight cut-backs between SRF 1.325 and 1.36 was such a level), so without the
-hand-over the cut-backs, not the body, set where the search's bracket closes, and the 100 iterations of each give-up
-were half the search's time. An iteration on a fixed matrix (``recheck_assemble`` given: the elastic stiffness with
-Anderson mixing) is re-checked by Newton on the consistent tangent, up to ``RECHECK_LIMIT`` x ``NEWTON_ITERATIONS``
-iterations; Newton's own iteration with ``RECHECK_LIMIT`` x ``max_iterations``. Why not more of the same patience:
-the elastic-stiffness iteration converges linearly at a rate that worsens as the cloud is refined and as the body
-nears collapse, and its residual is not monotone, so where it gives up depends on how long it is allowed to go on
-(measured: the slope, psi = 0, at h = 0.42 m, FE P2, failed at SRF 1.30 with the cap 100 re-checked at 200, at
-[1.3266, 1.3328] re-checked at 800 and at [1.3344, 1.3406] with the cap 400), while Newton either converges in a few
-iterations or runs away (the same slope by Newton throughout: [1.3361, 1.3377], the failed level's iterate
-diverging).
+iterate (up to ``NEWTON_ITERATIONS``; fewer where its residual keeps rising, ``HAND_OVER_RISES``) before it is
+cut back: near a limit the fixed-matrix iteration gives up at
+levels where Newton converges in 3-13 iterations (measured on the 1928-node slope: every one of its eight cut-backs
+between SRF 1.325 and 1.36 was such a level), so without the hand-over the cut-backs, not the body, set where the
+search's bracket closes, and the 100 iterations of each give-up were half the search's time. An iteration on a fixed
+matrix (``recheck_assemble`` given: the elastic stiffness with Anderson mixing) is re-checked by Newton on the
+consistent tangent, up to ``RECHECK_LIMIT`` x ``NEWTON_ITERATIONS`` iterations; Newton's own iteration with
+``RECHECK_LIMIT`` x ``max_iterations``. Why not more of the same patience: the elastic-stiffness iteration
+converges linearly at a rate that worsens as the cloud is refined and as the body nears collapse, and its
+residual is not monotone, so where it gives up depends on how long it is allowed to go on (measured: the slope,
+psi = 0, at h = 0.42 m, FE P2, failed at SRF 1.30 with the cap 100 re-checked at 200, at [1.3266, 1.3328] re-checked
+at 800 and at [1.3344, 1.3406] with the cap 400), while Newton either converges in a few iterations or runs away
+(the same slope by Newton throughout: [1.3361, 1.3377], the failed level's iterate diverging).
 """
 from __future__ import annotations
 
