@@ -81,6 +81,44 @@ def node_pattern_rows(indptr, indices, tptr, trow, n, r0, r1):
     return counts, cols[:used]
 
 
+@njit(cache=True, nogil=True)
+def _row_scratch(n, node_start, r0, r1):
+    """(pos, acc) of the node rows r0 <= I < r1 of :func:`stiffness_rows` and :func:`tangent_rows`: ``pos`` (n,)
+    each neighbour's place in the row being summed, ``acc`` the row's accumulator, four sums per neighbour (the 2 x
+    2 block of a pair side by side), sized for the widest of these rows."""
+    width = 0
+    for i in range(r0, r1):
+        width = max(width, node_start[i + 1] - node_start[i])
+    return np.empty(n, np.uint32), np.empty(4 * width)
+
+
+@njit(cache=True, nogil=True)
+def _start_row(pos, acc, neighbours, node_start, i):
+    """Node row i begins: each of its neighbours' place into ``pos``, its accumulator zeroed; (o, c): where its
+    neighbours start in ``neighbours``, and how many there are."""
+    o = uint64(node_start[i])
+    c = uint64(node_start[i + _1]) - o
+    for q in range(c):
+        pos[uint64(neighbours[o + q])] = q
+    for q in range(_4 * c):
+        acc[q] = 0.0
+    return o, c
+
+
+@njit(cache=True, nogil=True)
+def _pair_columns(k_indices, neighbours, o, c):
+    """The columns of node row I in the interleaved layout of :func:`stiffness_rows`: row 2I from 4 o, row 2I + 1
+    from 4 o + 2 c, each 2J, 2J + 1 for its c sorted neighbours J = neighbours[o:o + c]."""
+    o0 = _4 * o
+    o1 = o0 + _2 * c
+    for q in range(c):
+        j = uint64(neighbours[o + q])
+        k_indices[o0 + _2 * q] = _2 * j
+        k_indices[o0 + _2 * q + _1] = _2 * j + _1
+        k_indices[o1 + _2 * q] = _2 * j
+        k_indices[o1 + _2 * q + _1] = _2 * j + _1
+
+
 @njit(cache=True, nogil=True, fastmath=_FAST)
 def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n, node_start, neighbours, r0, r1,
                    k_indices, k_data, upper, corr, points, nodes, d_c, mode):
@@ -93,21 +131,12 @@ def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n,
     the rest. ``mode`` 1 or 2: the test gradients are (tdx, tdy) plus the correction of
     :class:`ctmrpim.discretisation.gradient_correction.GradientCorrection` (coefficients ``corr`` (n, 3, 2), linear
     or quadratic, at ``points`` over ``nodes``, scaled by ``d_c``), as its ``applied`` writes them; 0: as given."""
-    pos = np.empty(n, np.uint32)
-    width = 0
-    for i in range(r0, r1):
-        width = max(width, node_start[i + 1] - node_start[i])
-    acc = np.empty(4 * width)              # xx, xy, yx, yy of a pair side by side
+    pos, acc = _row_scratch(n, node_start, r0, r1)     # acc: xx, xy, yx, yy of a pair side by side
     d00, d01, d02 = D[0, 0], D[0, 1], D[0, 2]
     d10, d11, d12 = D[1, 0], D[1, 1], D[1, 2]
     d20, d21, d22 = D[2, 0], D[2, 1], D[2, 2]
     for i in range(uint64(r0), uint64(r1)):
-        o = uint64(node_start[i])
-        c = uint64(node_start[i + _1]) - o
-        for q in range(c):
-            pos[uint64(neighbours[o + q])] = q
-        for q in range(_4 * c):
-            acc[q] = 0.0
+        o, c = _start_row(pos, acc, neighbours, node_start, i)
         if mode > 0:
             cx0, cx1, cx2 = corr[i, 0, 0], corr[i, 1, 0], corr[i, 2, 0]
             cy0, cy1, cy2 = corr[i, 0, 1], corr[i, 1, 1], corr[i, 2, 1]
@@ -135,15 +164,11 @@ def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n,
                 acc[q + _1] += ax * by
                 acc[q + _2] += ay * bx
                 acc[q + _3] += ay * by
+        _pair_columns(k_indices, neighbours, o, c)
         o0 = _4 * o
         o1 = o0 + _2 * c
         for q in range(c):
-            j = uint64(neighbours[o + q])
-            k_indices[o0 + _2 * q] = _2 * j
-            k_indices[o0 + _2 * q + _1] = _2 * j + _1
-            k_indices[o1 + _2 * q] = _2 * j
-            k_indices[o1 + _2 * q + _1] = _2 * j + _1
-            if upper and j < i:
+            if upper and uint64(neighbours[o + q]) < i:
                 continue
             a, b, g, h = acc[_4 * q], acc[_4 * q + _1], acc[_4 * q + _2], acc[_4 * q + _3]
             # B~_I^T D B_J with B = [[d/dx, 0], [0, d/dy], [d/dy, d/dx]]
@@ -277,18 +302,9 @@ def tangent_rows(indptr, indices, dx, dy, tdx, tdy, w, A, tptr, trow, tent, n, n
     K[(I, i), (K, k)] = sum_p w_p sum_JL d~N_I/dX_J A[2i + J, 2k + L] dN_K/dX_L. ``upper``: K symmetric (test =
     trial, every A_p symmetric, the pattern's rows sorted): only the blocks K >= I are summed and written, as in
     :func:`stiffness_rows`; :func:`mirror_lower` writes the rest."""
-    pos = np.empty(n, np.uint32)
-    width = 0
-    for i in range(r0, r1):
-        width = max(width, node_start[i + 1] - node_start[i])
-    acc = np.empty(4 * width)              # the 2 x 2 block of a pair: (x, x), (x, y), (y, x), (y, y)
+    pos, acc = _row_scratch(n, node_start, r0, r1)     # acc: (x, x), (x, y), (y, x), (y, y) of a pair
     for i in range(uint64(r0), uint64(r1)):
-        o = uint64(node_start[i])
-        c = uint64(node_start[i + _1]) - o
-        for q in range(c):
-            pos[uint64(neighbours[o + q])] = q
-        for q in range(_4 * c):
-            acc[q] = 0.0
+        o, c = _start_row(pos, acc, neighbours, node_start, i)
         for t in range(uint64(tptr[i]), uint64(tptr[i + _1])):
             p = uint64(trow[t])
             e = uint64(tent[t])
@@ -311,15 +327,11 @@ def tangent_rows(indptr, indices, dx, dy, tdx, tdy, w, A, tptr, trow, tent, n, n
                 acc[q + _1] += v010 * bx + v011 * by
                 acc[q + _2] += v100 * bx + v101 * by
                 acc[q + _3] += v110 * bx + v111 * by
+        _pair_columns(k_indices, neighbours, o, c)
         o0 = _4 * o
         o1 = o0 + _2 * c
         for q in range(c):
-            j = uint64(neighbours[o + q])
-            k_indices[o0 + _2 * q] = _2 * j
-            k_indices[o0 + _2 * q + _1] = _2 * j + _1
-            k_indices[o1 + _2 * q] = _2 * j
-            k_indices[o1 + _2 * q + _1] = _2 * j + _1
-            if upper and j < i:
+            if upper and uint64(neighbours[o + q]) < i:
                 continue
             k_data[o0 + _2 * q] = acc[_4 * q]
             k_data[o0 + _2 * q + _1] = acc[_4 * q + _1]

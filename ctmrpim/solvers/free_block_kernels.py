@@ -1,6 +1,7 @@
 """Compiled (numba) passes of the linear solve over a sparse matrix's arrays: the free-free block of the
-constrained system (whole, as CSR, or its upper triangle), the product with a matrix held by its upper
-triangle, and the band of a symmetrically permuted matrix in LAPACK's storage (its width and its fill).
+constrained system (whole, as CSR, or its upper triangle), products with a CSR matrix (by blocks of rows) and
+with a matrix held by its upper triangle, and the band of a symmetrically permuted matrix in LAPACK's storage
+(its width and its fill).
 
 Why compiled: scipy's slicing of the free block copies K's rows and then its columns (160 MB each at 257 x 65
 nodes), and a permuted copy of K for the band is another; here each is one pass over K's arrays, writing only
@@ -13,11 +14,13 @@ from numba import njit
 
 
 @njit(cache=True, nogil=True)
-def constrained_csr(indptr, indices, data, new, values_at, rhs):
+def constrained_block(indptr, indices, data, new, values_at, rhs, upper):
     """The free-free block of a CSR matrix as CSR arrays, row by row (no scatter: a column-wise copy took five
-    times as long at 129 x 33 nodes): ``new[i]`` the free index of row/column i or -1 where it is prescribed;
-    rhs[new[r]] -= sum over prescribed columns c of A[r, c] values_at[c] (the prescribed values moved to the
-    right-hand side). Columns keep their order in each row (``new`` is increasing on the free dofs)."""
+    times as long at 129 x 33 nodes), or with ``upper`` only its upper triangle, diagonal included (half the
+    entries, for a symmetric matrix with sorted columns): ``new[i]`` the free index of row/column i or -1 where
+    it is prescribed; rhs[new[r]] -= sum over prescribed columns c of A[r, c] values_at[c] (the prescribed
+    values moved to the right-hand side, from the whole rows either way). Columns keep their order in each row
+    (``new`` is increasing on the free dofs)."""
     nf = 0
     for i in range(len(new)):
         if new[i] >= 0:
@@ -27,9 +30,10 @@ def constrained_csr(indptr, indices, data, new, values_at, rhs):
         nr = new[r]
         if nr < 0:
             continue
+        first = nr if upper else 0            # the first free column kept in this row
         count = 0
         for k in range(indptr[r], indptr[r + 1]):
-            if new[indices[k]] >= 0:
+            if new[indices[k]] >= first:
                 count += 1
         rptr[nr + 1] = count
     for i in range(nf):
@@ -40,55 +44,28 @@ def constrained_csr(indptr, indices, data, new, values_at, rhs):
         nr = new[r]
         if nr < 0:
             continue
+        first = nr if upper else 0
         t = rptr[nr]
         for k in range(indptr[r], indptr[r + 1]):
             c = new[indices[k]]
-            if c >= 0:
-                cols[t] = c
-                vals[t] = data[k]
-                t += 1
-            else:
-                rhs[nr] -= data[k] * values_at[indices[k]]
-    return rptr, cols, vals
-
-
-@njit(cache=True, nogil=True)
-def constrained_upper(indptr, indices, data, new, values_at, rhs):
-    """The upper triangle (diagonal included) of the free-free block of a symmetric CSR matrix with sorted
-    columns, as CSR arrays (half the entries of :func:`constrained_csr`'s block), and its right-hand side as
-    there, from the whole rows: ``new[i]`` the free index of row/column i or -1 where it is prescribed."""
-    nf = 0
-    for i in range(len(new)):
-        if new[i] >= 0:
-            nf += 1
-    rptr = np.zeros(nf + 1, np.int64)
-    for r in range(len(indptr) - 1):
-        nr = new[r]
-        if nr < 0:
-            continue
-        count = 0
-        for k in range(indptr[r], indptr[r + 1]):
-            if new[indices[k]] >= nr:
-                count += 1
-        rptr[nr + 1] = count
-    for i in range(nf):
-        rptr[i + 1] += rptr[i]
-    cols = np.empty(rptr[nf], indices.dtype)
-    vals = np.empty(rptr[nf])
-    for r in range(len(indptr) - 1):
-        nr = new[r]
-        if nr < 0:
-            continue
-        t = rptr[nr]
-        for k in range(indptr[r], indptr[r + 1]):
-            c = new[indices[k]]
-            if c >= nr:
+            if c >= first:
                 cols[t] = c
                 vals[t] = data[k]
                 t += 1
             elif c < 0:
                 rhs[nr] -= data[k] * values_at[indices[k]]
     return rptr, cols, vals
+
+
+@njit(cache=True, nogil=True)
+def csr_matvec(indptr, indices, data, x, y, r0, r1):
+    """y[r] = (A x)[r] for the rows r0 <= r < r1 of the CSR matrix (indptr, indices, data), summed along each row
+    in its order (scipy's order: the same bits), so that blocks of rows run on threads."""
+    for r in range(r0, r1):
+        s = 0.0
+        for k in range(indptr[r], indptr[r + 1]):
+            s += data[k] * x[indices[k]]
+        y[r] = s
 
 
 @njit(cache=True, nogil=True)

@@ -268,6 +268,24 @@ def test_non_symmetric_solve_by_gmres_on_the_symmetric_part_matches_superlu(monk
         assert np.abs(U - ref).max() <= 1e3 * ROUNDOFF * np.abs(ref).max()
 
 
+def test_product_by_blocks_of_rows_is_scipys_bit_for_bit() -> None:
+    """The compiled product of the Krylov solves (blocks of rows of about equal entries, on the threads) gives
+    scipy's sums exactly, on rows of very unequal length, empty ones at both ends included."""
+    from ctmrpim.solvers import linear_solver
+    rng = np.random.default_rng(8)
+    n = 300
+    A = sp.random(n, n, density=0.05, random_state=9, format="lil")
+    A[:40, :] = rng.random((40, n))                      # long rows first: the blocks split by entries, not rows
+    A[0, :] = 0.0
+    A[n - 1, :] = 0.0
+    A = A.tocsr()
+    A.eliminate_zeros()
+    x = rng.standard_normal(n)
+    op = linear_solver._product(A)
+    assert op is not A
+    assert np.array_equal(op @ x, A @ x)
+
+
 def test_band_of_the_symmetric_part_is_filled_from_the_matrix_itself() -> None:
     """fill_lower_band with average: the band of (A + A^T) / 2, diagonal included, without forming A^T."""
     from ctmrpim.solvers import free_block_kernels
