@@ -99,7 +99,7 @@ def test_warm_up_compiles_the_kernels_that_large_cases_take() -> None:
     sweep._warm_up()
     kernels = (rpim_kernels.support_counts, rpim_kernels.rpim_rows, stiffness_kernels.node_pattern_rows,
                stiffness_kernels.stiffness_rows, stiffness_kernels.mirror_lower, free_block_kernels.constrained_block,
-               free_block_kernels.symmetric_matvec,
+               free_block_kernels.symmetric_matvec, free_block_kernels.csr_matvec,
                free_block_kernels.lower_bandwidth, free_block_kernels.fill_lower_band, vci_kernels.moments,
                vci_kernels.corrected)
     assert [k.py_func.__name__ for k in kernels if not k.signatures] == []
