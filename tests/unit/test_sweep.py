@@ -90,10 +90,12 @@ def test_processes_and_in_process_agree(tmp_path) -> None:
 
 def test_warm_up_compiles_the_kernels_that_large_linear_cases_take() -> None:
     """The kernels that the linear path takes above the compiled thresholds are compiled (or loaded) by the
-    warm-up, before any timed case, so that no case's wall time holds their compilation. The timed studies
-    (time-to-accuracy, node density) solve linear cantilevers, which take the gradient correction as coefficients
-    applied in the stiffness kernel: ``vci_kernels.corrected`` (the corrected gradients as arrays, for the plastic
-    and large-deformation solvers) is not on their path, at any grid or scheme, so it is not asked of the warm-up."""
+    warm-up, before any timed case, so that no case's wall time holds their compilation. The studies that compare
+    wall times of linear solves (time-to-accuracy, node density, integration schemes) take the gradient correction
+    as coefficients applied in the stiffness kernel: ``vci_kernels.corrected`` (the corrected gradients as arrays,
+    for the plastic and large-deformation solvers) is not on their path, at any grid or scheme, so it is not asked
+    of the warm-up. (The nonlinear schemes' time ratios do take it; the warm-up does not cover the nonlinear
+    solvers.)"""
     from ctmrpim.discretisation import rpim_kernels, stiffness_kernels, vci_kernels
     from ctmrpim.solvers import free_block_kernels
     from studies import sweep
