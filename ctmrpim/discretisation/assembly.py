@@ -76,6 +76,34 @@ def stiffness(dNdx: sp.csr_matrix, dNdy: sp.csr_matrix, weights: np.ndarray, D: 
     return K
 
 
+def mass(N: sp.csr_matrix, weights: np.ndarray) -> sp.csr_matrix:
+    """M (n x n) = sum_p w_p N_p^T N_p from the shape functions ``N`` (m, n) at m points with ``weights`` (m,): the
+    mass matrix of the L2 projection onto the nodes (:mod:`ctmrpim.discretisation.state_transfer`). Its pattern is
+    every pair of nodes that share a point; column indices sorted. Large sets by the compiled
+    :func:`~ctmrpim.discretisation.stiffness_kernels.mass_rows` on K's node pattern (exactly symmetric; measured
+    on the 1071-node column's 9600 points, two threads: about 5 ms against 45 ms for scipy's N^T W N), small ones
+    by scipy's products (the two agree to round-off)."""
+    m, n = N.shape
+    if not rpim_kernels.use_compiled(N.nnz, COMPILED_MIN_ENTRIES):
+        return (N.T @ sp.diags(np.asarray(weights, dtype=float)) @ N).tocsr()
+    indptr, indices = N.indptr, N.indices
+    etype = np.int32 if N.nnz < 2**31 - 1 else np.int64
+    trow, tent = np.empty(N.nnz, etype), np.empty(N.nnz, etype)
+    tptr = kernels.transpose_pattern(indptr, indices, n, trow, tent)
+    blocks = [(a, min(a + ROW_BLOCK, n)) for a in range(0, n, ROW_BLOCK)]
+    node_start, neighbours = node_pattern(indptr, indices, tptr, trow, n, blocks)
+    data, w = np.ascontiguousarray(N.data, dtype=float), np.ascontiguousarray(weights, dtype=float)
+    m_data = np.empty(int(node_start[-1]))
+    run_blocks(lambda ab: kernels.mass_rows(indptr, indices, data, w, tptr, trow, tent, n, node_start, neighbours,
+                                            *ab, m_data), blocks, kernel=kernels.mass_rows)
+    itype = np.int32 if max(len(m_data), n) < 2**31 - 1 else np.int64
+    M = sp.csr_matrix((m_data, neighbours.astype(itype, copy=False), node_start.astype(itype)), shape=(n, n),
+                      copy=False)
+    M.has_sorted_indices = True
+    M.has_canonical_format = True
+    return M
+
+
 def node_pattern(indptr: np.ndarray, indices: np.ndarray, tptr: np.ndarray, trow: np.ndarray, n: int,
                  blocks: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
     """K's node pattern from the points' pattern (indptr, indices) over ``n`` nodes and its transpose (tptr,

@@ -1,4 +1,6 @@
-"""Compiled (numba) assembly of K = sum_p w_p B~_p^T D B_p (Eq. 5, in Eq. 9's form) on one sparse pattern.
+"""Compiled (numba) assembly of K = sum_p w_p B~_p^T D B_p (Eq. 5, in Eq. 9's form) on one sparse pattern, and of
+the scalar mass matrix M = sum_p w_p N_p^T N_p of the L2 projection onto the nodes (:func:`mass_rows`) on the same
+node pattern.
 
 Why compiled: as scipy products the stiffness takes sparse matrix products over the points (each with a
 symbolic pass, a numeric pass and the output sorted afterwards), then a block matrix and its conversion,
@@ -83,9 +85,10 @@ def node_pattern_rows(indptr, indices, tptr, trow, n, r0, r1):
 
 @njit(cache=True, nogil=True)
 def _row_scratch(n, node_start, r0, r1):
-    """(pos, acc) of the node rows r0 <= I < r1 of :func:`stiffness_rows` and :func:`tangent_rows`: ``pos`` (n,)
-    each neighbour's place in the row being summed, ``acc`` the row's accumulator, four sums per neighbour (the 2 x
-    2 block of a pair side by side), sized for the widest of these rows."""
+    """(pos, acc) of the node rows r0 <= I < r1 of :func:`stiffness_rows`, :func:`tangent_rows` and
+    :func:`mass_rows`: ``pos`` (n,) each neighbour's place in the row being summed, ``acc`` the row's accumulator,
+    four sums per neighbour (the 2 x 2 block of a pair side by side; the mass uses the first one per neighbour),
+    sized for the widest of these rows."""
     width = 0
     for i in range(r0, r1):
         width = max(width, node_start[i + 1] - node_start[i])
@@ -176,6 +179,26 @@ def stiffness_rows(indptr, indices, dx, dy, tdx, tdy, w, D, tptr, trow, tent, n,
             k_data[o0 + _2 * q + _1] = d01 * b + d02 * a + d21 * h + d22 * g
             k_data[o1 + _2 * q] = d10 * g + d12 * h + d20 * a + d22 * b
             k_data[o1 + _2 * q + _1] = d11 * h + d12 * g + d21 * b + d22 * a
+
+
+@njit(cache=True, nogil=True)
+def mass_rows(indptr, indices, N, w, tptr, trow, tent, n, node_start, neighbours, r0, r1, m_data):
+    """Rows r0 <= I < r1 of M = sum_p w_p N_p^T N_p (the L2 projection's mass matrix) into the CSR data of M's node
+    pattern (row I: columns ``neighbours[node_start[I]:node_start[I + 1]]``, sorted), with N the shape functions on
+    the points' pattern (indptr, indices) and (tptr, trow, tent) its transpose. Each term is w_p (N_I N_J), summed
+    over the points in ascending order: M_IJ and M_JI are the same sums, so M is exactly symmetric (no fastmath:
+    reassociation would break that)."""
+    pos, acc = _row_scratch(n, node_start, r0, r1)
+    for i in range(uint64(r0), uint64(r1)):
+        o, c = _start_row(pos, acc, neighbours, node_start, i)
+        for t in range(uint64(tptr[i]), uint64(tptr[i + _1])):
+            p = uint64(trow[t])
+            a = N[uint64(tent[t])]
+            wp = w[p]
+            for k in range(uint64(indptr[p]), uint64(indptr[p + _1])):
+                acc[uint64(pos[uint64(indices[k])])] += wp * (a * N[k])
+        for q in range(c):
+            m_data[o + q] = acc[q]
 
 
 @njit(cache=True, nogil=True)

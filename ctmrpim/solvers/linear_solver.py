@@ -323,6 +323,23 @@ def _product(A: Matrix) -> Matrix | spla.LinearOperator:
     return spla.LinearOperator(A.shape, matvec=apply, dtype=float)
 
 
+def banded_cholesky(A: sp.csr_matrix, max_entries: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """(permutation, double-precision lower banded Cholesky factor) of a symmetric positive definite A on the
+    narrower band of :func:`_band_order`, for :func:`banded_solve`, on one BLAS thread; None where the band would
+    hold more than ``max_entries`` numbers or A is not positive definite."""
+    with one_blas_thread():
+        order = _band_order(A, always=True)
+        if (order[2] + 1) * A.shape[0] > max_entries:
+            return None
+        return _band_factor(A, order, symmetric_part=False, dtype=np.float64)
+
+
+def banded_solve(factor: tuple[np.ndarray, np.ndarray], b: np.ndarray) -> np.ndarray:
+    """A^-1 b (b (n,) or (n, k)) from :func:`banded_cholesky`'s factor, on one BLAS thread."""
+    with one_blas_thread():
+        return _band_solve(factor, b)
+
+
 def _band_order(A: Matrix, always: bool, places: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, int] | None:
     """(permutation, its inverse: the rank of each row, lower half-bandwidth) of the narrower of two orderings of

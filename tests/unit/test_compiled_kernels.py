@@ -119,6 +119,22 @@ def test_stiffness_matches_a_dense_sum_over_points(general: bool) -> None:
     assert np.abs(K.toarray() - ref).max() <= ROUNDOFF * np.abs(ref).max()
 
 
+def test_projection_mass_matches_a_dense_sum_over_points_and_is_exactly_symmetric(jittered, monkeypatch) -> None:
+    """M = sum_p w_p N_p^T N_p (the L2 projection's mass) on an irregular cloud around a hole: the compiled rows
+    against a dense sum point by point, sorted columns, M - M^T exactly zero; the numpy path agrees to round-off."""
+    nodes, pts, d_c = jittered
+    sf = shape_functions(nodes, pts, 4 * d_c, 5.0, 3, d_c)
+    w = np.random.default_rng(6).uniform(0.5, 1.5, len(pts))
+    M = assembly.mass(sf.N, w)
+    N = sf.N.toarray()
+    ref = (N * w[:, None]).T @ N
+    assert M.has_sorted_indices and all(np.all(np.diff(M.indices[a:b]) > 0) for a, b in zip(M.indptr, M.indptr[1:]))
+    assert np.abs(M.toarray() - ref).max() <= ROUNDOFF * np.abs(ref).max()
+    assert abs(M - M.T).max() == 0.0
+    monkeypatch.setattr(assembly, "COMPILED_MIN_ENTRIES", 10**12)          # the small runs' scipy products
+    assert np.abs(assembly.mass(sf.N, w).toarray() - M.toarray()).max() <= ROUNDOFF * np.abs(ref).max()
+
+
 def test_subtract_in_place_on_the_pattern_or_as_a_new_matrix() -> None:
     K = sp.csr_matrix(np.array([[4.0, 1.0, 0.0], [1.0, 4.0, 1.0], [0.0, 1.0, 4.0]]))
     C = sp.csr_matrix(([0.5, 0.25], ([0, 1], [1, 2])), shape=(3, 3))
