@@ -83,7 +83,7 @@ def mass(N: sp.csr_matrix, weights: np.ndarray) -> sp.csr_matrix:
     :func:`~ctmrpim.discretisation.stiffness_kernels.mass_rows` on K's node pattern (exactly symmetric; measured
     on the 1071-node column's 9600 points, two threads: about 5 ms against 45 ms for scipy's N^T W N), small ones
     by scipy's products (the two agree to round-off)."""
-    m, n = N.shape
+    n = N.shape[1]
     if not rpim_kernels.use_compiled(N.nnz, COMPILED_MIN_ENTRIES):
         return (N.T @ sp.diags(np.asarray(weights, dtype=float)) @ N).tocsr()
     indptr, indices = N.indptr, N.indices

@@ -153,13 +153,15 @@ def update_rows(f, stress, plastic, viscous, dead, w, G, K, c, sphi, cphi, spsi,
         r3 = stress[p, 3]
         q0, q1, q2 = _rotate(plastic[p, 0], plastic[p, 1], plastic[p, 2], cq, sq)
         q3 = plastic[p, 3]
-        # the viscous stress of the step, beta D de / dt; the one of the last step did work on this one's strain
+        # the viscous stress of the step, beta D de / dt. The force of the state after step n carries the viscous
+        # stress of step n and does work over (de_n + de_{n+1}) / 2 in the central-difference ledger, so each
+        # viscous stress is booked half on the strain that made it and half on the next step's
         tr = e0 + e1
-        out_viscous[p, 0] = beta_dt * (lam * tr + 2.0 * G * e0)
-        out_viscous[p, 1] = beta_dt * (lam * tr + 2.0 * G * e1)
-        out_viscous[p, 2] = beta_dt * G * e2
+        v0, v1, v2 = beta_dt * (lam * tr + 2.0 * G * e0), beta_dt * (lam * tr + 2.0 * G * e1), beta_dt * G * e2
+        out_viscous[p, 0], out_viscous[p, 1], out_viscous[p, 2] = v0, v1, v2
         out_viscous[p, 3] = beta_dt * lam * tr
-        viscous_work[p] = w[p] * (viscous[p, 0] * e0 + viscous[p, 1] * e1 + viscous[p, 2] * e2)
+        viscous_work[p] = 0.5 * w[p] * ((viscous[p, 0] + v0) * e0 + (viscous[p, 1] + v1) * e1
+                                        + (viscous[p, 2] + v2) * e2)
         t0, t1, t2, t3, reg = _trial_and_return(r0, r1, r2, r3, e0, e1, e2, lam, G, K, c, sphi, cphi, spsi)
         region[p] = reg
         out_stress[p, 0], out_stress[p, 1], out_stress[p, 2], out_stress[p, 3] = t0, t1, t2, t3
@@ -198,8 +200,9 @@ def point_update(material: MohrCoulomb, f: np.ndarray, stress: np.ndarray, plast
     the Cauchy stress and plastic strain (m, 4: xx, yy, xy, zz) of the last step to the new ones, the
     return region of each point (:data:`ctmrpim.materials.mohr_coulomb.ELASTIC`, ...) and the plastic dissipation
     sum_p w_p (sigma_rotated + sigma_new) / 2 : d eps_p. With ``beta_dt`` = beta / dt > 0, also the
-    viscous stress of the step, beta D d eps / dt (stiffness-proportional damping), and the work that the
-    last step's viscous stress ``viscous`` did on this step's strain. Points marked ``dead`` come out
+    viscous stress of the step, beta D d eps / dt (stiffness-proportional damping), and the viscous work on this
+    step's strain: half of it done by the last step's viscous stress ``viscous``, half by this step's (each viscous
+    stress acts over two half steps in the central-difference ledger). Points marked ``dead`` come out
     stress-free with no plastic strain. Mohr-Coulomb without a tension cut-off only."""
     constants = return_constants(material, "point_update")
     m = len(f)

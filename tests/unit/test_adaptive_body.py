@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from ctmrpim.cases import load_case
-from ctmrpim.discretisation.state_transfer import project_to_nodes, transfer
+from ctmrpim.discretisation.state_transfer import local_bounds, project_to_nodes, transfer
 from ctmrpim.solvers.updated_lagrangian import adaptive_body
 
 E = 1.0e9
@@ -98,3 +99,30 @@ def test_transfer_is_exact_for_linear_fields_and_idempotent(tmp_path) -> None:
     once, _ = transfer(N, w, rough, N)
     twice, _ = transfer(N, w, once, N)
     assert np.abs(twice - once).max() <= 1e-9 * np.abs(once).max()
+
+
+def test_transfer_bounds_are_the_old_values_each_new_point_depends_on_and_leave_a_linear_field_exact(tmp_path) -> None:
+    """local_bounds against a dense search: a new point's range is that of the old points of positive weight in the
+    supports of its nodes. A linear field transferred to points moved by a tenth of the spacing, inside the old
+    points' hull, lies inside its bounds (the clip a solver applies changes nothing there)."""
+    body = body_of(tmp_path)
+    pts, N, d_c = body.points, body.sf.N, 2.0 / 12
+    rng = np.random.default_rng(4)
+    w = body.w.copy()
+    w[::7] = 0.0
+    new_pts = np.clip(pts + rng.uniform(-0.1, 0.1, pts.shape) * d_c, pts.min(axis=0), pts.max(axis=0))
+    N_new = body.conf.shape_functions_at(new_pts, derivatives=False).N
+    values = np.c_[np.sin(5 * pts[:, 0]) * pts[:, 1], rng.normal(size=len(pts))]
+    lo, hi = local_bounds(N, w, values, N_new)
+    pattern = lambda A: sp.csr_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape)
+    reach = (pattern(N_new) @ pattern(N).T).toarray() > 0
+    reach[:, ~(w > 0)] = False
+    assert reach.any(axis=1).all()
+    for k in range(values.shape[1]):
+        np.testing.assert_array_equal(lo[:, k], np.where(reach, values[None, :, k], np.inf).min(axis=1))
+        np.testing.assert_array_equal(hi[:, k], np.where(reach, values[None, :, k], -np.inf).max(axis=1))
+    linear = np.c_[1.0 + 2.0 * pts[:, 0] - 3.0 * pts[:, 1]]
+    at_new, _ = transfer(N, w, linear, N_new)
+    assert np.abs(at_new[:, 0] - (1.0 + 2.0 * new_pts[:, 0] - 3.0 * new_pts[:, 1])).max() < 1e-9
+    lo, hi = local_bounds(N, w, linear, N_new)
+    assert np.array_equal(np.clip(at_new, lo, hi), at_new)

@@ -43,7 +43,10 @@ def test_compiled_point_update_matches_the_numpy_forms(c, psi):
     want_viscous = 2.0 * np.c_[strain @ D.T, D[0, 1] * (strain[:, 0] + strain[:, 1])][:, [0, 1, 2, 3]]
     want_viscous[dead] = 0.0
     assert np.abs(viscous - want_viscous).max() < 1e-12 * np.abs(want_viscous).max()
-    assert work == pytest.approx(w[~dead] @ strain[~dead].sum(axis=1), rel=1e-12)   # unit old viscous stress
+    # half the work of the old (unit) viscous stress and half of the new one on this step's strain (each viscous
+    # stress acts over two half steps in the central-difference ledger)
+    both = strain.sum(axis=1) + (want_viscous[:, :3] * strain).sum(axis=1)
+    assert work == pytest.approx(0.5 * w[~dead] @ both[~dead], rel=1e-12)
 
 
 def _admissible_states(material: MohrCoulomb, seed: int, m: int = 5000) -> tuple[np.ndarray, np.ndarray]:

@@ -4,8 +4,9 @@
 the walls (their velocity corrections) is summed over the displacements dt (v_{n+1/2} + v_{n-1/2}) / 2,
 for which central differences balance energy exactly (any sequence of dt): W_gravity + W_damping +
 W_walls - W_internal = kinetic energy, to round-off (a check of the bookkeeping). Independently, at the
-points: elastic energy, plastic dissipation sum w sigma : d eps_p, viscous dissipation and the energy
-change of the transfers; W_internal against their sum measures the discretisation's error (the "material
+points: elastic energy, plastic dissipation sum w sigma : d eps_p, viscous dissipation and the elastic energy
+that the rebuilds changed (the state transfers, and the points dropped by a rebuild or inverted by a step, whose
+stress leaves with them); W_internal against their sum measures the discretisation's error (the "material
 balance").
 
 The works are booked by the step (:mod:`ctmrpim.solvers.explicit.step`), the transfers' change by the
@@ -31,7 +32,7 @@ class Energy:
     damping: float = 0.0       # work of the damping forces (<= 0)
     walls: float = 0.0         # work of the wall and support corrections (<= 0: dissipated by contact)
     plastic: float = 0.0       # plastic dissipation at the points
-    transfer: float = 0.0      # elastic energy changed by the state transfers at rebuilds
+    transfer: float = 0.0      # elastic energy changed by the rebuilds (state transfers, dropped points)
     viscous: float = 0.0       # dissipated by the viscous stress (explicit.viscosity)
     elastic0: float = 0.0      # elastic energy at t = 0
 

@@ -233,6 +233,7 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
             "dt": {"first": self.history[0]["dt"] if self.history else self.dt, "min": self.dt_range[0],
                    "max": self.dt_range[1], "wave_speed_bound": self.dt_wave, "setting": self.settings.dt},
             "rebuilds": self.rebuilds, "state_transfers": self.transfers, "returned_to_yield": self.returned,
+            "transfer_clipped": self.clipped,
             "boundaries_tracked": {"carried": self.tracking[0], "alpha_shape": self.tracking[1]},
             "re_tracking_failed": {"count": self.relay_failures, "first": self.relay_failure},
             "free_particles": {"final": len(self.x) - len(self.frame.active), "most": self.free_max,

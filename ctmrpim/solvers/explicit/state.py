@@ -53,6 +53,7 @@ class RunState:
     rebuilds: int                   # rebuilds, state transfers, transferred stresses returned to yield
     transfers: int
     returned: int
+    clipped: int                    # transferred points clipped to their old values' range (local_bounds)
     areas: list[float]              # area of the body at each re-tracking (the first: the initial one)
     area_changes: list[float]       # re-tracked over carried area - 1 at each re-tracking
     free_max: int                   # most free particles at once
@@ -84,6 +85,7 @@ class RunState:
         self.stage = "gravity" if self.settings.initial == "gravity" else "dynamic"
         self.t, self.step, self.stage_steps = 0.0, 0, 0
         self.rebuilds, self.transfers, self.returned, self.areas, self.free_max = 0, 0, 0, [self.frame.boundary.area], 0
+        self.clipped = 0
         self.area_changes = []
         self.relay_failures, self.relay_failure = 0, ""
         self.energy = Energy()
@@ -104,8 +106,8 @@ class RunState:
     def _meta(self) -> dict[str, Any]:
         return {"stage": self.stage, "t": self.t, "step": self.step, "stage_steps": self.stage_steps,
                 "dt": self.dt, "omega": self.omega, "dt_range": self.dt_range, "dt_wave": self.dt_wave,
-                "rebuilds": self.rebuilds, "transfers": self.transfers, "returned": self.returned, "areas": self.areas,
-                "area_changes": self.area_changes,
+                "rebuilds": self.rebuilds, "transfers": self.transfers, "returned": self.returned, "clipped": self.clipped,
+                "areas": self.areas, "area_changes": self.area_changes,
                 "free_max": self.free_max, "relay_failures": self.relay_failures,
                 "relay_failure": self.relay_failure, "dropped_points": self.dropped_points, "tracking": self.tracking,
                 "energy": asdict(self.energy), "ke_peak": self.ke_peak, "stage_residual": self.stage_residual,
@@ -127,7 +129,7 @@ class RunState:
         self.viscous = a["viscous"]
         self.laid = a["laid"]
         for k in ("stage", "t", "step", "stage_steps", "dt", "omega", "dt_range", "dt_wave", "rebuilds", "transfers",
-                  "returned", "areas", "area_changes", "free_max", "relay_failures", "relay_failure",
+                  "returned", "clipped", "areas", "area_changes", "free_max", "relay_failures", "relay_failure",
                   "dropped_points", "tracking", "ke_peak", "stage_residual",
                   "history", "next_save", "next_record"):
             setattr(self, k, meta[k])

@@ -38,7 +38,7 @@ from ctmrpim.materials.objective_stress import det_c, hughes_winget_c, relative_
 from ctmrpim.materials.objective_stress_kernels import weighted_first_piola
 from ctmrpim.problem.model import Wall
 from ctmrpim.solvers.explicit.contact import wall_table
-from ctmrpim.solvers.explicit.energy import contract
+from ctmrpim.solvers.explicit.energy import contract, elastic_density
 from ctmrpim.solvers.explicit.errors import Diverged
 from ctmrpim.solvers.explicit.frame import IDENTITY
 from ctmrpim.solvers.explicit.nodal_update import nodal_update
@@ -118,6 +118,9 @@ class CentralDifference:
             raise Diverged(f"the step inverts the material at {int(inverted.sum())} integration points (det f = "
                            f"{J[i]:.3g} at #{i} near ({p[0]:.5g}, {p[1]:.5g})) at step {self.step}, t = "
                            f"{self.t:.6g} s; use a smaller explicit.dt or explicit.cfl")
+        if self.stage == "dynamic":     # the step leaves them stress-free: their elastic energy leaves with them
+            self.energy.transfer -= float((fr.w[inverted] * det_c(F[inverted]))
+                                          @ elastic_density(self.material, self.stress[inverted]))
         fr.w[inverted] = 0.0
         self.dropped_points += int(inverted.sum())
 

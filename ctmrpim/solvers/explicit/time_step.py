@@ -3,8 +3,9 @@
 Central differences are stable for dt <= 2 / omega_max, omega_max^2 the largest eigenvalue of
 M^-1 K (lumped mass, elastic stiffness). omega_max is estimated by power iteration with the elastic
 internal-force operator of the current configuration (one gradient and one transposed product per
-iteration, no matrix assembled), warm-started from the last estimate's vector at each rebuild; the
-step is dt = cfl x 2 / omega_max (cfl = 0.5 covers the estimate's shortfall, plasticity and contact),
+iteration, no matrix assembled), started at each rebuild from the last estimate's vector plus a fresh
+checkerboard (:func:`warm_start`); the step is dt = cfl x 2 / omega_max (cfl = 0.5 covers the estimate's
+shortfall, plasticity and contact),
 shortened by the stiffness-proportional damping where there is one (:func:`stable_step`).
 The textbook bound 0.4 d_min / c_p (c_p the P-wave speed) is reported beside it. The explicit run
 recomputes the step on its frame at every rebuild (:class:`TimeStepping`).
@@ -68,6 +69,17 @@ def checkerboard(points: np.ndarray, d_c: float) -> np.ndarray:
     return np.c_[sign, -sign] + 1e-3 * np.c_[np.cos(points[:, 0] / d_c), np.sin(points[:, 1] / d_c)]
 
 
+def warm_start(mode: np.ndarray, fresh: np.ndarray, mass: np.ndarray) -> np.ndarray:
+    """(n, 2) the start of a later power iteration: the last stiffest ``mode`` plus a ``fresh`` start vector
+    (:func:`checkerboard`), each of unit mass-weighted norm. Why both: the last mode alone holds almost nothing of a
+    stiffer mode that has since grown elsewhere (two nodes squeezed together), and a few iterations from it miss it;
+    the checkerboard has every node's neighbours moving against each other. Measured at the 157 rebuilds of a
+    496-node collapse against the largest eigenvalue (ARPACK): WARM_ITERATIONS from the last mode alone gave down
+    to 0.653 of omega_max, from this start down to 0.842 (medians 1.000 both)."""
+    unit = lambda z: z / max(float(np.sqrt(mass @ np.einsum("nd,nd->n", z, z))), 1e-300)
+    return unit(mode) + unit(fresh)
+
+
 def wave_speed_step(d_min: float, E: float, nu: float, density: float, factor: float = 0.4) -> float:
     """factor x d_min / c_p, with the plane-strain P-wave modulus."""
     modulus = E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
@@ -95,10 +107,12 @@ class TimeStepping:
         return apply
 
     def _time_step(self) -> None:
-        """omega_max on the current frame (warm-started from ``mode`` after the first) and the step from it."""
+        """omega_max on the current frame (after the first, started from ``mode`` plus the checkerboard) and the
+        step from it."""
         s = self.settings
         first = not np.isfinite(self.dt_range[0])
-        omega, self.mode = omega_max(self._stiffness(self.frame), self.mass, self.mode, self.movable,
+        start = self.mode if first else warm_start(self.mode, checkerboard(self.X, self.d_c), self.mass)
+        omega, self.mode = omega_max(self._stiffness(self.frame), self.mass, start, self.movable,
                                      ITERATIONS if first else WARM_ITERATIONS)
         self.omega = omega
         self.dt = float(s.dt) if s.dt != "cfl" else stable_step(omega, s.cfl, s.viscosity)
