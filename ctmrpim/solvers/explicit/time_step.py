@@ -5,8 +5,8 @@ M^-1 K (lumped mass, elastic stiffness). omega_max is estimated by power iterati
 internal-force operator of the current configuration (one gradient and one transposed product per
 iteration, no matrix assembled), started at each rebuild from the last estimate's vector plus a fresh
 checkerboard (:func:`warm_start`); the step is dt = cfl x 2 / omega_max (cfl = 0.5 covers the estimate's
-shortfall, plasticity and contact),
-shortened by the stiffness-proportional damping where there is one (:func:`stable_step`).
+shortfall, plasticity and contact), shortened by the stiffness-proportional damping where there is one
+(:func:`stable_step`).
 The textbook bound 0.4 d_min / c_p (c_p the P-wave speed) is reported beside it. The explicit run
 recomputes the step on its frame at every rebuild (:class:`TimeStepping`).
 
