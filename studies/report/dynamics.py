@@ -96,8 +96,8 @@ def write_momentum_conservation(w: Writer, flights: pd.DataFrame, operators: pd.
       f"{vci.resultant:.1e} of sum |f_i| (`ctm`: {ctm.resultant:.1e}) and a torque of {vci.torque:.1e} "
       f"({ctm.torque:.1e}), and the elastic operator of the time step is not symmetric (|A - A^T| / |A| = "
       f"{vci.asymmetry:.1e}, eigenvalues with imaginary parts up to {vci.imaginary:.1e} of the largest; `ctm`: "
-      f"{ctm.asymmetry:.1e}, all real, so the power iteration's omega_max, "
-      f"{abs(ctm.omega_power_iteration / ctm.omega_max - 1):.1%} below the largest eigenvalue's, is sound). "
+      f"{ctm.asymmetry:.1e}, all real, so the LOBPCG estimate of omega_max, "
+      f"{abs(ctm.omega_estimate / ctm.omega_max - 1):.1%} below the largest eigenvalue's, is sound). "
       "Explicit analyses therefore integrate with `ctm` and refuse `ctm-vci`.\n\n")
     w(md(flights[[c for c in ("case", "integration", "steps", "rebuilds", "transfers", "linear_drift",
                               "angular_drift", "spin_rad_s", "turns") if c in flights]]))

@@ -104,7 +104,7 @@ def test_transfer_is_exact_for_linear_fields_and_idempotent(tmp_path) -> None:
 def test_transfer_bounds_are_the_old_values_each_new_point_depends_on_and_leave_a_linear_field_exact(tmp_path) -> None:
     """local_bounds against a dense search: a new point's range is that of the old points of positive weight in the
     supports of its nodes. A linear field transferred to points moved by a tenth of the spacing, inside the old
-    points' hull, lies inside its bounds (the clip a solver applies changes nothing there)."""
+    points' hull, lies inside its bounds to round-off (the clip a solver applies changes nothing there)."""
     body = body_of(tmp_path)
     pts, N, d_c = body.points, body.sf.N, 2.0 / 12
     rng = np.random.default_rng(4)
@@ -125,4 +125,5 @@ def test_transfer_bounds_are_the_old_values_each_new_point_depends_on_and_leave_
     at_new, _ = transfer(N, w, linear, N_new)
     assert np.abs(at_new[:, 0] - (1.0 + 2.0 * new_pts[:, 0] - 3.0 * new_pts[:, 1])).max() < 1e-9
     lo, hi = local_bounds(N, w, linear, N_new)
-    assert np.array_equal(np.clip(at_new, lo, hi), at_new)
+    # at most round-off: a new point on an old one at the hull's corner holds the bound, its projection an ulp off
+    assert np.abs(np.clip(at_new, lo, hi) - at_new).max() <= 1e-12 * np.abs(linear).max()

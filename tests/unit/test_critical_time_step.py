@@ -1,4 +1,4 @@
-"""The explicit solver's stable time step: the power-iteration estimate of the highest frequency."""
+"""The explicit solver's stable time step: the LOBPCG estimate of the highest frequency."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -12,7 +12,7 @@ from ctmrpim.solvers.explicit.run import ExplicitRun
 
 
 def test_critical_time_step_bounds_the_wave_speed_step():
-    """The power-iteration step is stable and of the order of d / c_p (RPIM is stiffer than linear FEM)."""
+    """The estimated step is stable and of the order of d / c_p (RPIM is stiffer than linear FEM)."""
     case = benchmarks.load("column-collapse", QUICK)
     run = ExplicitRun(case, Path("unused"), "key")
     run.start()

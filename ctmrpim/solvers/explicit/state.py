@@ -41,7 +41,7 @@ class RunState:
     force_of_F: tuple[np.ndarray, Configuration, np.ndarray] | None = None   # (F, frame, F_int there), as the step
                                     # scattered it for the stress it left (to be cleared where that stress changes)
     laid: np.ndarray                # (m, 4) deformation gradient since the points were laid, up to the frame
-    mode: np.ndarray                # (n, 2) the power iteration's vector (time step)
+    mode: np.ndarray                # (n, 2) the time step estimate's vector
     dt: float                       # the time step
     omega: float                    # the frame's largest circular frequency (omega_max)
     dt_range: list[float]           # [smallest, largest] time step so far
