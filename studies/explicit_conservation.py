@@ -126,13 +126,16 @@ def fly(flight: Flight, steps: int, corrected: bool = False, dt: float | None = 
         run.v[:] = flight.velocity(run.X, run.mass)
         impulse = run.mass.sum() * np.asarray(case.problem.gravity, float)
         p0, L0 = momenta(run.mass, run.x, run.v)
+        dt_first = run.dt
         linear = angular = 0.0
         for _ in range(steps):
             run.advance([], 0.0)
             run.rebuild_if_needed()
             p, L = momenta(run.mass, run.x, run.v)
             size = float(run.mass @ np.linalg.norm(run.v, axis=1))
-            linear = max(linear, float(np.linalg.norm(p - p0 - impulse * run.t)) / size)
+            # gravity's impulse acts from v_{-1/2} to v_{n+1/2}: t - (dt_n - dt_0) / 2 (h of the varying step)
+            elapsed = run.t - 0.5 * (run.dt_previous - dt_first)
+            linear = max(linear, float(np.linalg.norm(p - p0 - impulse * elapsed)) / size)
             angular = max(angular, abs(L - L0) / abs(L0))
         seconds = time.perf_counter() - start
     return {"case": flight.name, "integration": "ctm-vci (force only)" if corrected else "ctm", "steps": steps,

@@ -202,6 +202,7 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
         self.viscous[:] = 0.0            # at rest: no strain rate
         self.force_of_F = None           # the force of the last step had the viscous stress in it
         self.stage, self.t, self.step = "dynamic", 0.0, 0
+        self.dt_previous = self.dt       # at rest: v_{-1/2} = 0, the first step a full one as from start()
         self.energy = Energy(elastic0=self.elastic_energy())
         self.record()
         self.save()
@@ -225,7 +226,7 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
         ke, elastic = self.kinetic_energy(), self.elastic_energy()
         released = e.gravity
         balance = e.gravity + e.damping + e.walls - e.internal - ke
-        material_error = e.internal - (elastic - e.elastic0 + e.plastic + e.viscous - e.transfer)
+        material_error = e.internal - e.rebuild - (elastic - e.elastic0 + e.plastic + e.viscous - e.transfer)
         timings = self.timer.total()
         steps = max(self.step + self.stage_steps, 1)
         dynamics = {
@@ -242,7 +243,7 @@ class ExplicitRun(RunState, FrameBuilder, TimeStepping, CentralDifference, Rebui
             "energy": {"gravity_work": released, "kinetic": ke, "elastic": elastic, "elastic_initial": e.elastic0,
                        "plastic_dissipation": e.plastic, "wall_dissipation": -e.walls,
                        "damping_dissipation": -e.damping, "viscous_dissipation": e.viscous,
-                       "transfer_change": e.transfer, "internal_work": e.internal,
+                       "transfer_change": e.transfer, "rebuild_force_change": e.rebuild, "internal_work": e.internal,
                        "central_difference_balance": balance / max(abs(released), 1e-300),
                        "material_balance": material_error / max(abs(released), 1e-300)},
             "mass": {"total": float(self.mass.sum()), "min_nodal": float(self.mass.min())},

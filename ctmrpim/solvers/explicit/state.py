@@ -84,6 +84,7 @@ class RunState:
                                        self.material.density)
         self.stage = "gravity" if self.settings.initial == "gravity" else "dynamic"
         self.t, self.step, self.stage_steps = 0.0, 0, 0
+        self.dt_previous = self.dt       # the last step's dt; the first step's own: v is taken as v_{-1/2}
         self.rebuilds, self.transfers, self.returned, self.areas, self.free_max = 0, 0, 0, [self.frame.boundary.area], 0
         self.clipped = 0
         self.area_changes = []
@@ -105,7 +106,7 @@ class RunState:
 
     def _meta(self) -> dict[str, Any]:
         return {"stage": self.stage, "t": self.t, "step": self.step, "stage_steps": self.stage_steps,
-                "dt": self.dt, "omega": self.omega, "dt_range": self.dt_range, "dt_wave": self.dt_wave,
+                "dt": self.dt, "dt_previous": self.dt_previous, "omega": self.omega, "dt_range": self.dt_range, "dt_wave": self.dt_wave,
                 "rebuilds": self.rebuilds, "transfers": self.transfers, "returned": self.returned, "clipped": self.clipped,
                 "areas": self.areas, "area_changes": self.area_changes,
                 "free_max": self.free_max, "relay_failures": self.relay_failures,
@@ -128,7 +129,7 @@ class RunState:
         self.stress, self.plastic, self.F, self.mode = a["stress"], a["plastic"], a["F"], a["mode"]
         self.viscous = a["viscous"]
         self.laid = a["laid"]
-        for k in ("stage", "t", "step", "stage_steps", "dt", "omega", "dt_range", "dt_wave", "rebuilds", "transfers",
+        for k in ("stage", "t", "step", "stage_steps", "dt", "dt_previous", "omega", "dt_range", "dt_wave", "rebuilds", "transfers",
                   "returned", "clipped", "areas", "area_changes", "free_max", "relay_failures", "relay_failure",
                   "dropped_points", "tracking", "ke_peak", "stage_residual",
                   "history", "next_save", "next_record"):

@@ -2,8 +2,9 @@
 
     M a = F_ext - F_int + F_damp,       F_damp = -f |F_ext - F_int| sign(v)                  (Eqs. 9-11)
 
-Central differences with the half-step velocity: v_{n+1/2} = v_{n-1/2} + dt M^-1 F_n, then contact with
-the rigid walls (:mod:`ctmrpim.solvers.explicit.contact`) and fixed dofs, x_{n+1} = x_n + dt v_{n+1/2}. M is
+Central differences with the half-step velocity: v_{n+1/2} = v_{n-1/2} + h M^-1 F_n, h = (dt_{n-1} + dt_n) / 2
+(the step changes at rebuilds; the first step takes the velocity it starts from as v_{-1/2}, h = dt_0), then
+contact with the rigid walls (:mod:`ctmrpim.solvers.explicit.contact`) and fixed dofs, x_{n+1} = x_n + dt_n v_{n+1/2}. M is
 the lumped mass of the initial cloud (:mod:`ctmrpim.discretisation.lumped_mass`: positive, constant, so mass is
 conserved exactly), F_ext the nodal weight m g, f = 0 by default (true dynamics). F_int and the stress
 update act on the frame (:mod:`ctmrpim.solvers.explicit.frame`); the step books the works of the energy
@@ -66,7 +67,8 @@ class CentralDifference:
             f_int = fr.weighted_force(wP)
         v, x, f = np.empty_like(self.v), np.empty_like(self.x), np.empty_like(self.x)
         works = np.zeros(4 if self.stage == "dynamic" else 0)
-        bad = nodal_update(f_int, self.weight, self.mass, self.movable, self.v, self.x, dt, float(damping),
+        h = 0.5 * (self.dt_previous + dt)      # from v_{n-1/2} to v_{n+1/2} (nodal_update's docstring)
+        bad = nodal_update(f_int, self.weight, self.mass, self.movable, self.v, self.x, dt, h, float(damping),
                            wall_table(tuple(walls)), works, v, x, f)
         if bad >= 0:
             raise Diverged(f"non-finite velocity at node #{bad} ({self.x[bad, 0]:.5g}, {self.x[bad, 1]:.5g}) at step "
@@ -102,6 +104,7 @@ class CentralDifference:
         self.x, self.v, self.F = x, v, F_new
         self.stress, self.plastic, self.viscous = upd.stress, upd.plastic, upd.viscous
         self.t += dt
+        self.dt_previous = dt
         self.step += 1
 
     def _drop_inverted(self, inverted: np.ndarray, x: np.ndarray, F: np.ndarray) -> None:
