@@ -4,7 +4,7 @@ On the coarse cloud (31 x 16 nodes) the collapse is repeated with the rebuild cr
 (``explicit.rebuild_strain``: RPIM rebuilt on the current nodes once a point has been strained this
 much since the last rebuild) halved and doubled, with new CTM points laid twice as often
 (``explicit.relay_strain``), and with the paper's fixed time step of 5 microseconds instead of the
-stable step from the power iteration (``explicit.dt``). The runs go to t = 0.3 s, the middle of the
+stable step from the LOBPCG estimate (``explicit.dt``). The runs go to t = 0.3 s, the middle of the
 flow, while the front still moves, and are compared there: the front (farthest x where the surface is
 0.01 m high) and the largest vertical distance of each surface from the fixed-step run's. Quick mode (CI): two rebuild criteria for 0.1 s.
 """
