@@ -31,10 +31,10 @@ from ctmrpim.solvers.explicit.contact import contact
 def nodal_update(f_int, weight, mass, movable, v_old, x, dt, h, damping, walls, works, v, x_new, f):
     """v (n, 2) <- v_{n+1/2}, x_new (n, 2) <- x_{n+1}, f (n, 2) <- F_ext - F_int from the internal force ``f_int``,
     the nodal weights m g ``weight``, the lumped ``mass`` (n,), the free dofs ``movable`` (n, 2), v_{n-1/2}
-    ``v_old`` and x_n ``x``, the step ``dt`` and the velocity's step ``h``; ``damping`` the local damping f_l, ``walls`` the contact table
-    (:func:`ctmrpim.solvers.explicit.contact.wall_table`). Where ``works`` has 4 entries the step's works of
-    gravity, internal force, damping and walls are added into them (the dynamic stage). Returns the first node
-    whose velocity is not finite, or -1."""
+    ``v_old`` and x_n ``x``, the step ``dt`` and the velocity's step ``h``; ``damping`` the local damping f_l,
+    ``walls`` the contact table (:func:`ctmrpim.solvers.explicit.contact.wall_table`). Where ``works`` has 4
+    entries the step's works of gravity, internal force, damping and walls are added into them (the dynamic stage).
+    Returns the first node whose velocity is not finite, or -1."""
     book = works.shape[0] == 4
     bad = -1
     wg = wi = wd = ww = 0.0

@@ -130,7 +130,6 @@ class Rebuilds:
         self.areas.append(area)
         self.timer.lap("transfer")
 
-
     def _force_of_state(self) -> np.ndarray:
         """(n, 2) F_int of the present state on the present frame: the last point pass's where it scattered it, else
         computed, and kept for the next step (the same kernel and blocks, the same bits)."""

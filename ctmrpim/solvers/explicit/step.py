@@ -4,8 +4,8 @@
 
 Central differences with the half-step velocity: v_{n+1/2} = v_{n-1/2} + h M^-1 F_n, h = (dt_{n-1} + dt_n) / 2
 (the step changes at rebuilds; the first step takes the velocity it starts from as v_{-1/2}, h = dt_0), then
-contact with the rigid walls (:mod:`ctmrpim.solvers.explicit.contact`) and fixed dofs, x_{n+1} = x_n + dt_n v_{n+1/2}. M is
-the lumped mass of the initial cloud (:mod:`ctmrpim.discretisation.lumped_mass`: positive, constant, so mass is
+contact with the rigid walls (:mod:`ctmrpim.solvers.explicit.contact`) and fixed dofs, x_{n+1} = x_n + dt_n v_{n+1/2}.
+M is the lumped mass of the initial cloud (:mod:`ctmrpim.discretisation.lumped_mass`: positive, constant, so mass is
 conserved exactly), F_ext the nodal weight m g, f = 0 by default (true dynamics). F_int and the stress
 update act on the frame (:mod:`ctmrpim.solvers.explicit.frame`); the step books the works of the energy
 accounts (:mod:`ctmrpim.solvers.explicit.energy`).

@@ -14,9 +14,9 @@ Why the estimate is sound: with the paper's CTM (the only scheme of explicit ana
 K = G^T W C G is symmetric positive semi-definite (the same gradients G test and trial, C the elasticity
 tensor with its symmetries), so M^-1/2 K M^-1/2 has real, non-negative eigenvalues and the Rayleigh quotient
 rises to omega_max^2 (measured on the quick column: asymmetry 8e-17, omega_max 4696.91 rad/s from 30 LOBPCG
-steps against 4696.93 from the eigenvalues; 30 power iterations gave 4680). The corrected test gradients of ``ctm-vci`` would make it non-symmetric
-(asymmetry 1.5e-2, eigenvalues with imaginary parts up to 1.1e-4 of the largest): one of the reasons explicit
-analyses integrate with ``ctm`` (:mod:`ctmrpim.solvers.explicit.run`).
+steps against 4696.93 from the eigenvalues; 30 power iterations gave 4680). The corrected test gradients of
+``ctm-vci`` would make it non-symmetric (asymmetry 1.5e-2, eigenvalues with imaginary parts up to 1.1e-4 of the
+largest): one of the reasons explicit analyses integrate with ``ctm`` (:mod:`ctmrpim.solvers.explicit.run`).
 """
 from __future__ import annotations
 
