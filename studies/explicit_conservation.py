@@ -4,7 +4,7 @@ CTM (``"ctm"``) and not with the consistent scheme (``"ctm-vci"``; issue 17, ite
 **Why "ctm" conserves momentum.** With linear-reproducing RPIM gradients, sum_I grad N_I = 0 and
 sum_I x_I (x) grad N_I = F at every point, so the internal forces F_int = sum_p w_r P grad_r N of
 :mod:`ctmrpim.solvers.explicit.frame` have no resultant and, F P^T = J sigma being symmetric, no torque.
-Central differences then give p_{n+1/2} = p_{n-1/2} + dt M g, and the angular momentum about the centre of mass,
+Central differences then give p_{n+1/2} = p_{n-1/2} + h M g (h = (dt_{n-1} + dt_n) / 2), and the angular momentum about the centre of mass,
 sum m (x_{n+1} - c_{n+1}) x (v_{n+1/2} - V_{n+1/2}) (positions after the step, half-step velocities), does not
 change, to round-off; rebuilds and state transfers change neither x nor v. The elastic operator
 K = G^T W C G of the stable time step is symmetric, so its eigenvalues are real and the LOBPCG estimate of
