@@ -36,7 +36,6 @@ from ctmrpim.discretisation.state_transfer import local_bounds
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import ELASTIC
 from ctmrpim.materials.objective_stress import det_c, largest_strain_c
-from ctmrpim.materials.objective_stress_kernels import weighted_first_piola
 from ctmrpim.solvers.explicit.energy import elastic_density
 from ctmrpim.solvers.explicit.errors import Diverged
 from ctmrpim.solvers.explicit.frame import IDENTITY, project_onto_nodes
@@ -58,7 +57,7 @@ class Rebuilds:
         if (known[1] if known is not None and known[0] is self.F else largest_strain_c(self.F)) <= s.rebuild_strain:
             return False
         old, F = self.frame, self.F
-        f_old = self._force_of_state()
+        f_old = self.force_of_state()
         w_now = old.w * det_c(F)
         self.laid = compose(F, self.laid)
         relay = largest_strain_c(self.laid) > s.relay_strain
@@ -89,7 +88,7 @@ class Rebuilds:
             self.energy.transfer += float((new.w - w_now) @ elastic_density(self.material, self.stress))
         self.frame = new
         self.F = np.tile(IDENTITY, (len(new.w), 1))
-        f_new = self._force_of_state()
+        f_new = self.force_of_state()
         if self.stage == "dynamic":       # energy.Energy.rebuild: the force's change over the last half step
             self.energy.rebuild += 0.5 * self.dt_previous * float(np.sum((f_new - f_old) * self.v))
         self.rebuilds += 1
@@ -129,18 +128,6 @@ class Rebuilds:
         self.transfers += 1
         self.areas.append(area)
         self.timer.lap("transfer")
-
-    def _force_of_state(self) -> np.ndarray:
-        """(n, 2) F_int of the present state on the present frame: the last point pass's where it scattered it, else
-        computed, and kept for the next step (the same kernel and blocks, the same bits)."""
-        known = self.force_of_F
-        if known is not None and known[0] is self.F and known[1] is self.frame:
-            return known[2]
-        wP = np.empty((len(self.frame.w), 4))
-        weighted_first_piola(self.stress, self.viscous, bool(self.settings.viscosity), self.F, self.frame.w, wP)
-        force = self.frame.weighted_force(wP)
-        self.force_of_F = (self.F, self.frame, force)
-        return force
 
 
 def compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:

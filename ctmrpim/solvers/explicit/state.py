@@ -106,10 +106,10 @@ class RunState:
 
     def _meta(self) -> dict[str, Any]:
         return {"stage": self.stage, "t": self.t, "step": self.step, "stage_steps": self.stage_steps,
-                "dt": self.dt, "dt_previous": self.dt_previous, "omega": self.omega, "dt_range": self.dt_range, "dt_wave": self.dt_wave,
-                "rebuilds": self.rebuilds, "transfers": self.transfers, "returned": self.returned, "clipped": self.clipped,
-                "areas": self.areas, "area_changes": self.area_changes,
-                "free_max": self.free_max, "relay_failures": self.relay_failures,
+                "dt": self.dt, "dt_previous": self.dt_previous, "omega": self.omega, "dt_range": self.dt_range,
+                "dt_wave": self.dt_wave, "rebuilds": self.rebuilds, "transfers": self.transfers,
+                "returned": self.returned, "clipped": self.clipped, "areas": self.areas,
+                "area_changes": self.area_changes, "free_max": self.free_max, "relay_failures": self.relay_failures,
                 "relay_failure": self.relay_failure, "dropped_points": self.dropped_points, "tracking": self.tracking,
                 "energy": asdict(self.energy), "ke_peak": self.ke_peak, "stage_residual": self.stage_residual,
                 "history": self.history, "series": self.series.entries, "next_save": self.next_save,
@@ -129,10 +129,10 @@ class RunState:
         self.stress, self.plastic, self.F, self.mode = a["stress"], a["plastic"], a["F"], a["mode"]
         self.viscous = a["viscous"]
         self.laid = a["laid"]
-        for k in ("stage", "t", "step", "stage_steps", "dt", "dt_previous", "omega", "dt_range", "dt_wave", "rebuilds", "transfers",
-                  "returned", "clipped", "areas", "area_changes", "free_max", "relay_failures", "relay_failure",
-                  "dropped_points", "tracking", "ke_peak", "stage_residual",
-                  "history", "next_save", "next_record"):
+        for k in ("stage", "t", "step", "stage_steps", "dt", "dt_previous", "omega", "dt_range", "dt_wave", "rebuilds",
+                  "transfers", "returned", "clipped", "areas", "area_changes", "free_max", "relay_failures",
+                  "relay_failure", "dropped_points", "tracking", "ke_peak", "stage_residual", "history", "next_save",
+                  "next_record"):
             setattr(self, k, meta[k])
         self.energy = Energy(**meta["energy"])
         self.at_rest = False

@@ -56,13 +56,13 @@ def omega_max(stiffness: Callable[[np.ndarray], np.ndarray], mass: np.ndarray, s
             out[:, j] = (stiffness(z.reshape(-1, 2) / root) / root).ravel()[dofs]
         return out
 
-    operator = LinearOperator((dofs.size, dofs.size), matvec=lambda v: apply(v.reshape(-1, 1))[:, 0],
-                              matmat=apply, dtype=float)
-    x0 = (start * root).ravel()[dofs]
     if dofs.size < DENSE_BELOW:        # LOBPCG needs five times its block; a small body's matrix is cheap to build
         lam, vec = np.linalg.eigh(apply(np.eye(dofs.size)))
         lam, vec = lam[-1:], vec[:, -1:]
     else:
+        operator = LinearOperator((dofs.size, dofs.size), matvec=lambda v: apply(v.reshape(-1, 1))[:, 0],
+                                  matmat=apply, dtype=float)
+        x0 = (start * root).ravel()[dofs]
         with warnings.catch_warnings():    # a fixed number of steps: "not reaching the requested tolerance" is expected
             warnings.simplefilter("ignore", UserWarning)
             lam, vec = lobpcg(operator, (x0 / np.linalg.norm(x0))[:, None], largest=True, tol=1e-12,
