@@ -187,7 +187,8 @@ class StrengthReduction:
     solver: str = "newton"          # how each level is equilibrated
     start: float = 1.0              # the SRF of the gravity stage (the search starts stable there)
     step: float = 0.1               # SRF rise per level until the first failure
-    width: float = 0.01             # bisection stops when failed - stable <= width
+    width: float = 0.01             # bisection stops when failed - stable <= width; no SRF sub-step is cut
+                                    # back below it
     max_srf: float = 5.0            # give up (no failure found) beyond this
     steps: int = 4                  # SRF sub-steps per level (halved on non-convergence like load steps)
     limit_growth: float = 100.0     # search by Newton: a level whose largest displacement from the stable one below,

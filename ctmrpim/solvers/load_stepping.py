@@ -151,7 +151,7 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
                recheck: bool = False, snapshot: Callable[[], Any] | None = None,
                restore: Callable[[Any], None] | None = None,
                recheck_assemble: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray, sp.spmatrix]] | None = None,
-               stop: Callable[[float, np.ndarray], str | None] | None = None) -> LoadPath:
+               stop: Callable[[float, np.ndarray], str | None] | None = None, resolution: float = 0.0) -> LoadPath:
     """Apply the load in increments of the load factor from 0 up to 1 (cut-backs, the response criterion
     ``judge`` with ``snapshot`` and ``restore``, the ``recheck`` and its ``recheck_assemble``: the module doc).
 
@@ -162,17 +162,23 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
     no cut-back left the solve raises a ConvergenceError with the history so far, or with ``stop_on_failure``
     returns the path so far with ``failed_at`` set. ``anderson = m > 0``: :class:`Anderson` mixing of depth m.
     ``stop(factor, U)``, where given, reads every converged increment before the last once it is carried and returns why the path
-    ends there (the path is returned with ``stopped`` set, its last increment carried) or None."""
+    ends there (the path is returned with ``stopped`` set, its last increment carried) or None. ``resolution`` > 0: an
+    increment at most that long (in load factor) that does not converge is not cut back further: the caller needs the
+    failure no closer than that (a strength-reduction level whose sub-step is already narrower than the search's
+    ``width``); it is re-checked like one whose cut-backs are spent."""
     path = LoadPath(U=np.zeros(n_dofs) if U0 is None else U0.copy())
     start_values = path.U[fixed].copy()
     walk = _Walk(factor=0.0, dfactor=1.0 / loading.steps, max_step=1.0 / loading.steps)
     report = progress.current()
     min_step = 1.0 / loading.steps / 2 ** loading.max_cutbacks
 
+    def resolved() -> bool:
+        return walk.dfactor <= resolution * (1 + 1e-9)
+
     def exhausted() -> bool:
         if judge is None:
-            return path.cutbacks >= loading.max_cutbacks
-        return walk.dfactor <= min_step * (1 + 1e-9)
+            return path.cutbacks >= loading.max_cutbacks or resolved()
+        return walk.dfactor <= max(min_step, resolution) * (1 + 1e-9)
 
     def newton(target: float, cap: int, assemble: Callable = assemble, start: np.ndarray | None = None,
                rises: int = 0) -> tuple[np.ndarray, bool, int]:
@@ -197,7 +203,10 @@ def step_loads(n_dofs: int, loading: Loading, fixed: np.ndarray, fixed_values: n
         if converged and judge is not None:
             verdict, judged = judge(walk.factor, path.U, target, trial)
         if not converged or verdict is not None:
-            reason = verdict if verdict is not None else f"no convergence after {loading.max_cutbacks} cut-backs"
+            reason = verdict if verdict is not None else (
+                f"no convergence after {path.cutbacks} cut-back(s), the increment ({walk.dfactor:.4g}) within the "
+                f"resolution asked for ({resolution:.4g})" if resolved() and path.cutbacks < loading.max_cutbacks
+                else f"no convergence after {loading.max_cutbacks} cut-backs")
             entry = {"load_factor": target, "converged": False, "equilibrium": converged, "iterations": it}
             if (exhausted() and walk.before is not None
                     and walk.factor - walk.before[0] > ROLLBACK * min_step * (1 + 1e-9)):

@@ -348,10 +348,11 @@ class PlasticSystem:
             load_at: Callable[[float], float], on_converged: Callable[[float, np.ndarray], dict[str, Any]],
             fixed_values: np.ndarray | None = None, stop_on_failure: bool = False,
             judge: Callable[[float, np.ndarray, float, np.ndarray], tuple[str | None, dict]] | None = None,
-            recheck: bool = False, stop: Callable[[float, np.ndarray], str | None] | None = None) -> LoadPath:
+            recheck: bool = False, stop: Callable[[float, np.ndarray], str | None] | None = None,
+            resolution: float = 0.0) -> LoadPath:
         """Step a path parameter t from 0 to 1 from the committed state: the material is
         ``material_at(t)`` and the loads are at ``load_at(t)`` times their full value (a load ramp,
-        or a strength-reduction stage at constant load); ``judge``, ``recheck`` and ``stop`` as in
+        or a strength-reduction stage at constant load); ``judge``, ``recheck``, ``stop`` and ``resolution`` as in
         :func:`~ctmrpim.solvers.load_stepping.step_loads`."""
         if self.tangent != "elastic":
             self._K = None
@@ -375,7 +376,7 @@ class PlasticSystem:
                               converged, U0=self.U, stop_on_failure=stop_on_failure, anderson=ANDERSON,
                               judge=judge, recheck=recheck, snapshot=self.snapshot, restore=self.restore,
                               recheck_assemble=assemble_consistent if self.tangent == "elastic" else None,
-                              stop=stop)
+                              stop=stop, resolution=resolution)
 
     def elastic_response(self, F: np.ndarray) -> np.ndarray:
         """U (2n,) of the elastic stiffness under the forces F (2n,), zero at the fixed dofs."""

@@ -9,8 +9,9 @@ it stays 0; a tension cut-off, a strength like c, is divided by SRF too), and th
 under its full loads, by one of two solvers:
 
 - ``solver = "newton"``: load stepping (:mod:`ctmrpim.solvers.load_stepping`); a level is **failed** when Newton
-  cannot reach equilibrium: the SRF sub-step was cut back ``loading.max_cutbacks`` times and still did
-  not converge within ``loading.max_iterations`` iterations;
+  cannot reach equilibrium: the SRF sub-step was cut back ``loading.max_cutbacks`` times, or until it was no
+  wider than ``width`` (a narrower one cannot make the bracket any more useful: the search stops at that width),
+  and still did not converge within ``loading.max_iterations`` iterations;
 - ``solver = "dynamic-relaxation"`` (the paper's, :mod:`ctmrpim.solvers.dynamic_relaxation`): the reduction
   applied at once and relaxed; a level is **failed** when it is still moving after ``dynamic.steps``
   steps (not at rest, and its maximum displacement grew by more than ``SETTLED_GROWTH`` over the last
@@ -52,7 +53,8 @@ CRITERION = {"newton": "displacement runaway or non-convergence: a level is fail
                        "strength-reduction.limit_growth times the largest displacement at SRF = start (the response: "
                        "the SRF-displacement curve turning flat), or when the equilibrium iteration (loading.tangent: "
                        "Newton, or the elastic stiffness with Anderson mixing) does not reach the residual and "
-                       "displacement tolerance at an SRF sub-step cut back loading.max_cutbacks times (where the iteration is "
+                       "displacement tolerance at an SRF sub-step cut back loading.max_cutbacks times or until it is no "
+                       "wider than strength-reduction.width (where the iteration is "
                        "the elastic stiffness's, every sub-step it does not converge is handed over to Newton on the "
                        "consistent tangent before it is cut back), re-checked before it counts (by Newton on the "
                        "consistent tangent where the iteration was the elastic stiffness's, with 8 times its cap)",
@@ -120,7 +122,7 @@ def _relax_level(system: PlasticSystem, relaxation: Relaxation, material: MohrCo
 
 
 def _level(system: PlasticSystem, loading, material_at, load_at, srf_at: Callable[[float], float], fixed_values=None,
-           recheck: bool = True, runaway: Callable[[float, np.ndarray], Level] | None = None
+           recheck: bool = True, runaway: Callable[[float, np.ndarray], Level] | None = None, resolution: float = 0.0
            ) -> tuple[Level, Level | None]:
     """Run the path t = 0..1 from the committed state; returns the level at t = 1 (stable, or failed
     at the sub-step that did not converge) and, for a failed level whose sub-steps got part of the way, the
@@ -145,7 +147,8 @@ def _level(system: PlasticSystem, loading, material_at, load_at, srf_at: Callabl
 
     with _progress.current().stage(f"SRF {srf_at(1.0):.4f}"):   # Newton's increments, labelled with the level
         path = system.run(loading, material_at, load_at, converged, fixed_values=fixed_values,
-                          stop_on_failure=True, recheck=recheck, stop=None if runaway is None else stop)
+                          stop_on_failure=True, recheck=recheck, stop=None if runaway is None else stop,
+                          resolution=resolution)
     seconds = timer.elapsed()
     if path.stopped is not None:
         t, state = carried[-1]
@@ -211,7 +214,8 @@ def search(system: PlasticSystem, loading: Loading, material: MohrCoulomb, setti
             level, reached = _relax_level(system, relaxation, reduced(material, target), target, fixed_values), None
         else:
             level, reached = _level(system, level_loading, lambda t: reduced(material, srf_at(t)), lambda t: 1.0,
-                                    srf_at, fixed_values, runaway=runaway if settings.limit_growth > 0 else None)
+                                    srf_at, fixed_values, runaway=runaway if settings.limit_growth > 0 else None,
+                                    resolution=settings.width / (target - s0))
         if reached is not None:   # the cut-back sub-steps converged part of the way: stable there
             _judge(stable, reached, reference, settings.limit_growth)
             progress(reached)

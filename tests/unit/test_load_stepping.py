@@ -138,3 +138,28 @@ def test_stop_ends_the_path_at_the_increment_it_names() -> None:
     assert np.allclose(seen, [0.1, 0.2, 0.3, 0.4])
     whole = path(lambda t, U: "runaway" if t > 0.95 else None)
     assert whole.stopped is None and np.isclose(whole.U[0], 1.0) and len(whole.history) == 10
+
+
+def test_an_increment_within_the_resolution_is_not_cut_back() -> None:
+    """The tanh body (no equilibrium beyond t = 2/3) by Newton on its true tangent in four increments, eight
+    cut-backs allowed: with ``resolution`` 0.1 an increment that fails is halved only while it is longer than 0.1,
+    and the path ends at the first failing one of 0.0625 (three cut-backs, the history saying why), its bracket
+    [last carried, failed] holding t = 2/3 and at most 0.1 wide; without it the eight cut-backs are all spent for a
+    narrower bracket, the same increments carried up to the coarse path's failure."""
+    loading = Loading(steps=4, tolerance=1e-8, max_iterations=30, max_cutbacks=8)
+
+    def path(resolution):
+        return step_loads(1, loading, np.array([], int), np.array([]), _tanh_body, lambda K, r: r / K[0, 0],
+                          lambda t, U: {}, stop_on_failure=True, resolution=resolution)
+
+    coarse, fine = path(0.1), path(0.0)
+    assert (coarse.cutbacks, fine.cutbacks) == (3, 8)
+    for p in (coarse, fine):
+        carried = max(h["load_factor"] for h in p.history if h["converged"])
+        assert carried < 2 / 3 < p.failed_at
+    assert coarse.failed_at - max(h["load_factor"] for h in coarse.history if h["converged"]) <= 0.1
+    assert "the increment (0.0625) within the resolution asked for (0.1)" in coarse.history[-1]["note"]
+    assert "no convergence after 8 cut-backs" in fine.history[-1]["note"]
+    assert coarse.history == fine.history[:len(coarse.history) - 1] + coarse.history[-1:]
+    assert coarse.history[-1]["load_factor"] == fine.history[len(coarse.history) - 1]["load_factor"]
+    assert coarse.newton_iterations < fine.newton_iterations
