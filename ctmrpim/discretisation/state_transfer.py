@@ -16,9 +16,12 @@ crowd into a thin layer (the toe of a collapsing column, pressed flat on its bas
 (measured on the 496-node collapse at t = 0.55 s: four eigenvalues of the diagonally scaled M_c below 3e-15), the
 nodal values there are set by round-off (5e7 Pa from point stresses of at most 2.6e3 Pa) and new points beside
 those nodes take them. :func:`local_bounds` gives each new point the range of the old values that it depends on:
-the old points of positive weight in the supports of the new point's nodes. A solver clips the transferred values
-to it and counts what it clipped. A field the RPIM space holds stays inside that range at every new point inside
-the old points' hull, so the clip leaves the exact cases exact.
+the old points of positive weight in the supports of the new point's nodes. A field the RPIM space holds stays
+inside that range at every new point inside the old points' hull. A solver replaces the state of a new point whose
+projected value leaves that range by :func:`convex_average`, the weighted mean of those same old values, and counts
+the points it replaced: the exact cases stay exact, and the replaced points make neither a new extremum nor
+elastic energy (clipping each component to its range instead still combined the extremes of different components:
+on the 496-node collapse one transfer tripled the column's elastic energy that way, docs/design.md).
 """
 from __future__ import annotations
 
@@ -91,6 +94,21 @@ def local_bounds(N_old: sp.csr_matrix, w_old: np.ndarray, values: np.ndarray, N_
     unbounded = ~(lo <= hi)
     lo[unbounded], hi[unbounded] = -np.inf, np.inf
     return lo, hi
+
+
+def convex_average(N_old: sp.csr_matrix, w_old: np.ndarray, values: np.ndarray, N_new: sp.csr_matrix,
+                   rows: np.ndarray) -> np.ndarray:
+    """(len(rows), k) averages of ``values`` (m_old, k) for the new points ``rows`` over the old points that each
+    depends on (those of :func:`local_bounds`), weighted by |N_new| |N_old|^T w_old: a convex combination, so every
+    component stays inside its local bounds, and a convex function of the state (the elastic energy density, the
+    yield function) is at most the weighted mean of its old values (Jensen). A new point without an old point of
+    positive weight in reach gets NaN."""
+    live = np.flatnonzero(w_old > 0)
+    weights = sp.csr_matrix(abs(sp.csr_matrix(N_new)[rows]) @ (abs(sp.csr_matrix(N_old)[live]).T
+                                                                @ sp.diags(np.asarray(w_old, float)[live])))
+    total = np.asarray(weights.sum(axis=1)).ravel()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.asarray(weights @ np.asarray(values, float)[live]) / total[:, None]
 
 
 def _segment_reduce(indptr: np.ndarray, indices: np.ndarray, values: np.ndarray, ufunc: np.ufunc,

@@ -8,7 +8,7 @@ import pytest
 import scipy.sparse as sp
 
 from ctmrpim.cases import load_case
-from ctmrpim.discretisation.state_transfer import local_bounds, project_to_nodes, transfer
+from ctmrpim.discretisation.state_transfer import convex_average, local_bounds, project_to_nodes, transfer
 from ctmrpim.solvers.updated_lagrangian import adaptive_body
 
 E = 1.0e9
@@ -127,3 +127,29 @@ def test_transfer_bounds_are_the_old_values_each_new_point_depends_on_and_leave_
     lo, hi = local_bounds(N, w, linear, N_new)
     # at most round-off: a new point on an old one at the hull's corner holds the bound, its projection an ulp off
     assert np.abs(np.clip(at_new, lo, hi) - at_new).max() <= 1e-12 * np.abs(linear).max()
+
+
+def test_convex_average_stays_in_the_bounds_keeps_a_constant_and_makes_no_energy(tmp_path) -> None:
+    """The fallback of a transferred point that leaves its bounds: a weighted mean of the old values the point
+    depends on. Each component lies inside local_bounds, a constant state comes through exactly, and a convex
+    function of the whole state (a quadratic energy density) is at most its largest old value in reach; the same
+    state clipped component by component combines the extremes of different components and exceeds it."""
+    body = body_of(tmp_path)
+    pts, N, d_c = body.points, body.sf.N, 2.0 / 12
+    rng = np.random.default_rng(7)
+    w = body.w.copy()
+    w[::5] = 0.0
+    new_pts = np.clip(pts + rng.uniform(-0.2, 0.2, pts.shape) * d_c, pts.min(axis=0), pts.max(axis=0))
+    N_new = body.conf.shape_functions_at(new_pts, derivatives=False).N
+    rows = np.arange(0, len(new_pts), 3)
+    state = rng.normal(size=(len(pts), 2)) * np.array([1.0, 1e3])    # two components of different scales
+    lo, hi = local_bounds(N, w, state, N_new)
+    avg = convex_average(N, w, state, N_new, rows)
+    scale = np.abs(state).max(axis=0)
+    assert np.all(avg >= lo[rows] - 1e-12 * scale) and np.all(avg <= hi[rows] + 1e-12 * scale)
+    np.testing.assert_allclose(convex_average(N, w, np.full((len(pts), 2), 3.5), N_new, rows), 3.5, rtol=1e-14)
+    density = lambda s: np.einsum("pi,ij,pj->p", s / scale, np.array([[2.0, 1.0], [1.0, 2.0]]), s / scale)
+    old_max = local_bounds(N, w, density(state)[:, None], N_new)[1][rows, 0]
+    assert np.all(density(avg) <= old_max * (1 + 1e-12))
+    corners = np.c_[hi[rows, 0], hi[rows, 1]]           # what a per-component clip can reach
+    assert np.any(density(corners) > old_max)

@@ -8,9 +8,10 @@ x_r), weights w det F) and which keep their stress and plastic strain exactly. O
 strained by more than ``relay_strain`` since the points were laid, the boundary is re-tracked (alpha
 shape) and new CTM points are laid over it (the paper's step (3)-(4)); the stress and plastic strain
 are then L2-projected onto the nodes over the old points and evaluated at the new ones
-(:mod:`ctmrpim.discretisation.state_transfer`), clipped to the range of the old values each new point depends on
-(:func:`~ctmrpim.discretisation.state_transfer.local_bounds`; where nodes crowd into a thin layer the projection
-is singular to round-off; the points clipped are counted), projected stresses outside the yield surface are
+(:mod:`ctmrpim.discretisation.state_transfer`); a new point whose projected state leaves the range of the old
+values it depends on (:func:`~ctmrpim.discretisation.state_transfer.local_bounds`; where nodes crowd into a thin
+layer the projection is singular to round-off) takes their convex average instead
+(:func:`~ctmrpim.discretisation.state_transfer.convex_average`; such points are counted as ``clipped``), projected stresses outside the yield surface are
 returned to it and counted, and the elastic energy the projection changed is booked. Why two levels: laying new points
 and transferring the state at every rebuild (measured on the 496-node collapse, 271 transfers)
 smooths the stress of a cohesionless body that sits at yield almost everywhere, and the deposit kept
@@ -32,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from ctmrpim.discretisation.configuration import Configuration
-from ctmrpim.discretisation.state_transfer import local_bounds
+from ctmrpim.discretisation.state_transfer import convex_average, local_bounds
 from ctmrpim.errors import ProblemError
 from ctmrpim.materials.mohr_coulomb import ELASTIC
 from ctmrpim.materials.objective_stress import det_c, largest_strain_c
@@ -112,12 +113,14 @@ class Rebuilds:
         carried = np.c_[self.stress, self.plastic, self.viscous]
         at_new = np.asarray(new.N @ project_onto_nodes(old, w_now, carried))
         lo, hi = local_bounds(old.N, w_now, carried, new.N)
-        clipped = np.clip(at_new, lo, hi)
-        # counted where the clip moved a value by more than round-off of its component's scale
-        scale = np.abs(carried).max(axis=0)
-        moved = (np.abs(clipped - at_new) > 1e-9 * scale).any(axis=1) & (new.w > 0)
-        self.clipped += int(np.count_nonzero(moved))
-        at_new = clipped
+        # a point whose projection leaves its old values' range by more than round-off of the component's scale
+        # takes their convex average, whole (each component clipped alone would combine their extremes)
+        slack = 1e-9 * np.abs(carried).max(axis=0)
+        outside = np.flatnonzero(((at_new < lo - slack) | (at_new > hi + slack)).any(axis=1) & (new.w > 0))
+        if len(outside):
+            at_new[outside] = convex_average(old.N, w_now, carried, new.N, outside)
+        at_new = np.clip(at_new, lo, hi)     # round-off only, and the points out of every old point's reach
+        self.clipped += len(outside)
         stress, region = self.material.update(at_new[:, :4], np.zeros((len(at_new), 3)))
         self.returned += int(np.count_nonzero(region != ELASTIC))
         self.stress, self.plastic, self.viscous = stress, at_new[:, 4:8], at_new[:, 8:]
