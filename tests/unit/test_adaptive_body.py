@@ -101,17 +101,22 @@ def test_transfer_is_exact_for_linear_fields_and_idempotent(tmp_path) -> None:
     assert np.abs(twice - once).max() <= 1e-9 * np.abs(once).max()
 
 
+def moved_points(body, seed: int, every: int, shift: float):
+    """The body's points, shape functions and weights (every ``every``-th weight 0), and new points moved at random
+    by up to ``shift`` of the spacing inside the old points' hull with their shape functions, and the generator."""
+    pts, N, d_c = body.points, body.sf.N, 2.0 / 12
+    rng = np.random.default_rng(seed)
+    w = body.w.copy()
+    w[::every] = 0.0
+    new_pts = np.clip(pts + rng.uniform(-shift, shift, pts.shape) * d_c, pts.min(axis=0), pts.max(axis=0))
+    return pts, N, w, new_pts, body.conf.shape_functions_at(new_pts, derivatives=False).N, rng
+
+
 def test_transfer_bounds_are_the_old_values_each_new_point_depends_on_and_leave_a_linear_field_exact(tmp_path) -> None:
     """local_bounds against a dense search: a new point's range is that of the old points of positive weight in the
     supports of its nodes. A linear field transferred to points moved by a tenth of the spacing, inside the old
     points' hull, lies inside its bounds to round-off (the clip a solver applies changes nothing there)."""
-    body = body_of(tmp_path)
-    pts, N, d_c = body.points, body.sf.N, 2.0 / 12
-    rng = np.random.default_rng(4)
-    w = body.w.copy()
-    w[::7] = 0.0
-    new_pts = np.clip(pts + rng.uniform(-0.1, 0.1, pts.shape) * d_c, pts.min(axis=0), pts.max(axis=0))
-    N_new = body.conf.shape_functions_at(new_pts, derivatives=False).N
+    pts, N, w, new_pts, N_new, rng = moved_points(body_of(tmp_path), seed=4, every=7, shift=0.1)
     values = np.c_[np.sin(5 * pts[:, 0]) * pts[:, 1], rng.normal(size=len(pts))]
     lo, hi = local_bounds(N, w, values, N_new)
     pattern = lambda A: sp.csr_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape)
@@ -134,13 +139,7 @@ def test_convex_average_stays_in_the_bounds_keeps_a_constant_and_makes_no_energy
     depends on. Each component lies inside local_bounds, a constant state comes through exactly, and a convex
     function of the whole state (a quadratic energy density) is at most its largest old value in reach; the same
     state clipped component by component combines the extremes of different components and exceeds it."""
-    body = body_of(tmp_path)
-    pts, N, d_c = body.points, body.sf.N, 2.0 / 12
-    rng = np.random.default_rng(7)
-    w = body.w.copy()
-    w[::5] = 0.0
-    new_pts = np.clip(pts + rng.uniform(-0.2, 0.2, pts.shape) * d_c, pts.min(axis=0), pts.max(axis=0))
-    N_new = body.conf.shape_functions_at(new_pts, derivatives=False).N
+    pts, N, w, new_pts, N_new, rng = moved_points(body_of(tmp_path), seed=7, every=5, shift=0.2)
     rows = np.arange(0, len(new_pts), 3)
     state = rng.normal(size=(len(pts), 2)) * np.array([1.0, 1e3])    # two components of different scales
     lo, hi = local_bounds(N, w, state, N_new)
