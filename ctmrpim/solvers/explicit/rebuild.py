@@ -119,7 +119,7 @@ class Rebuilds:
         outside = np.flatnonzero(((at_new < lo - slack) | (at_new > hi + slack)).any(axis=1) & (new.w > 0))
         if len(outside):
             at_new[outside] = convex_average(old.N, w_now, carried, new.N, outside)
-        at_new = np.clip(at_new, lo, hi)     # round-off only, and the points out of every old point's reach
+        at_new = np.clip(at_new, lo, hi)     # round-off only (a point out of every old point's reach has no bounds)
         self.clipped += len(outside)
         stress, region = self.material.update(at_new[:, :4], np.zeros((len(at_new), 3)))
         self.returned += int(np.count_nonzero(region != ELASTIC))
