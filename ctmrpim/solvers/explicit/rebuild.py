@@ -11,12 +11,13 @@ are then L2-projected onto the nodes over the old points and evaluated at the ne
 (:mod:`ctmrpim.discretisation.state_transfer`); a new point whose projected state leaves the range of the old
 values it depends on (:func:`~ctmrpim.discretisation.state_transfer.local_bounds`; where nodes crowd into a thin
 layer the projection is singular to round-off) takes their convex average instead
-(:func:`~ctmrpim.discretisation.state_transfer.convex_average`; such points are counted as ``clipped``), projected stresses outside the yield surface are
-returned to it and counted, and the elastic energy the projection changed is booked. Why two levels: laying new points
-and transferring the state at every rebuild (measured on the 496-node collapse, 271 transfers)
-smooths the stress of a cohesionless body that sits at yield almost everywhere, and the deposit kept
-creeping after the flow had stopped; carried points keep the state and cost only the RPIM solve. A
-re-tracked area that differs from the previous re-tracking's by more than ``area_jump`` stops the run
+(:func:`~ctmrpim.discretisation.state_transfer.convex_average`; such points are counted as ``clipped``),
+projected stresses outside the yield surface are returned to it and counted, and the elastic energy the
+projection changed is booked. Why two levels: laying new points and transferring the state at every rebuild
+(measured on the 496-node collapse, 271 transfers) smooths the stress of a cohesionless body that sits at yield
+almost everywhere, and the deposit kept creeping after the flow had stopped; carried points keep the state and
+cost only the RPIM solve. A re-tracked area that differs from the previous re-tracking's by more than
+``area_jump`` stops the run
 (the alpha shape opened or closed a gap: the body is nearly isochoric, so its alpha shape keeps its
 area). The carried points' area (sum of w det F) is not the reference: where the front thins out, the
 cohesionless material dilates at zero stress (the Mohr-Coulomb apex) and the nodes spread beyond

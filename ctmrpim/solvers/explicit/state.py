@@ -53,7 +53,7 @@ class RunState:
     rebuilds: int                   # rebuilds, state transfers, transferred stresses returned to yield
     transfers: int
     returned: int
-    clipped: int                    # transferred points whose projection left their old values' range: convex average instead
+    clipped: int                    # transferred points out of their old values' range (convex average instead)
     areas: list[float]              # area of the body at each re-tracking (the first: the initial one)
     area_changes: list[float]       # re-tracked over carried area - 1 at each re-tracking
     free_max: int                   # most free particles at once
