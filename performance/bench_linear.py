@@ -7,8 +7,9 @@ package, solves a 9 x 3 cantilever of the same method to warm up, then solves th
 Printed for each case, all measured in this one run: the first solve's total (numba's cached kernels are
 loaded there), the best total of the repeats and its phases, and the process's maximum resident memory
 (``ru_maxrss`` of the child) after all the repeats and after the first solve (a process that solves once, as
-``ctmrpim run`` does; the repeats add the allocator's fragmentation). Methods: CTM-RPIM with the default integration (``ctm-vci``) and with the
-paper's ``ctm``, scikit-fem Q1 and P2. Then the CTM-RPIM / FEM time ratios at equal grid, and, with three
+``ctmrpim run`` does; the repeats add the allocator's fragmentation). Also printed: numba's start alone
+(:func:`numba_start`). Methods: CTM-RPIM with the default integration (``ctm-vci``) and with the paper's ``ctm``,
+scikit-fem Q1 and P2. Then the CTM-RPIM / FEM time ratios at equal grid (best and first solves), and, with three
 grids or more, the scaling exponent of each phase (time ~ n^p), the ratios at equal tip error and each method's
 time to 0.1 % tip error (log-log between the bracketing grids, from the best and from the first solve). BLAS
 threads follow the environment. Timings on a shared machine are noisy: the minimum over repeats is the
@@ -74,6 +75,16 @@ def child(grid: str, label: str, repeat: int) -> None:
     print(json.dumps(out))
 
 
+def numba_start() -> float:
+    """Seconds numba's CPU target takes to initialise (its typing and lowering registries) in a fresh process,
+    after the imports of the command line: the fixed part of what a first compiled call costs."""
+    code = ("import time, ctmrpim.cli; from numba.core.registry import cpu_target; t = time.perf_counter(); "
+            "cpu_target.typing_context.refresh(); cpu_target.target_context.refresh(); "
+            "print(time.perf_counter() - t)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return float(proc.stdout.strip().splitlines()[-1])
+
+
 def run_case(grid: str, label: str, repeat: int) -> dict:
     proc = subprocess.run([sys.executable, __file__, "--child", grid, label, str(repeat)],
                           capture_output=True, text=True)
@@ -108,17 +119,23 @@ def main() -> None:
             rows.append(run_case(g, label, min(a.repeat, 2) if size > 10000 else a.repeat))
             r = rows[-1]
             phases = "  ".join(f"{k[2:]} {v:.3f}" for k, v in r.items() if k.startswith("t_") and k != "t_total")
-            print(f"{r['grid']:>7} {r['method']:13s} n={r['n']:6d} total {r['t_total']:7.3f} s (first {r['first']:.3f}) "
-                  f"max RSS {r['rss_MB']:6.0f} MB (one solve {r['rss_first_MB']:4.0f})  tip error {100 * r['tip_error']:.4f} %  | {phases}", flush=True)
+            print(f"{r['grid']:>7} {r['method']:13s} n={r['n']:6d} total {r['t_total']:7.3f} s "
+                  f"(first {r['first']:.3f}) max RSS {r['rss_MB']:6.0f} MB (one solve {r['rss_first_MB']:4.0f})  "
+                  f"tip error {100 * r['tip_error']:.4f} %  | {phases}", flush=True)
     df = pd.DataFrame(rows)
     if a.csv:
         df.to_csv(a.csv, index=False)
-    print("\nCTM-RPIM / FEM at equal grid (best total time of each; tip error):")
+    print(f"\nnumba's start in a fresh process after the package's imports (its target initialisation, paid by the "
+          f"first compiled call whatever the kernels are; inside the first solve's total): {numba_start():.3f} s")
+    print("\nCTM-RPIM / FEM at equal grid (best total time of each, and the first solves' as `ctmrpim run` counts "
+          "them; tip error):")
     for g in grids:
         d = df[df.grid == g].set_index("method")
         for ours in (m for m in d.index if m.startswith("ctm-rpim")):
             print(f"  {g:>7} {ours:13s}: " + "; ".join(
-                f"/ {m}: time x{d.t_total[ours] / d.t_total[m]:.2f}, error x{d.tip_error[ours] / d.tip_error[m]:.3g}"
+                f"/ {m}: time x{d.t_total[ours] / d.t_total[m]:.2f} "
+                f"(first solves x{d['first'][ours] / d['first'][m]:.2f}), "
+                f"error x{d.tip_error[ours] / d.tip_error[m]:.3g}"
                 for m in d.index if m.startswith("fem")))
     if len(grids) >= 3:
         from studies.fitting import fitted_rate
